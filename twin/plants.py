@@ -1,0 +1,55 @@
+"""Named plant presets: a parameter set, a valve model and the gain set the
+controllers use on it.
+
+``thesis``
+    What the thesis simulated (§8, "friction model assumed perfect"): the
+    plant is the controllers' model. Valve: ``averaged`` eq. 4.4.2 at every
+    duty above 0 % (the feed-forward inverts eq. 4.4.2 down to small duties,
+    so a plant equal to that model has no dead zone), with the 5 ms opening and
+    2 ms closing delays. Force loss: eq. 4.5.5 with eq. 4.5.7 only (no separate
+    stiction, which eq. 4.5.5 does not contain). Constant 300 kPa supply,
+    incompressible water, sealed chambers lock the joint. Simulation gains.
+``thesis-deadzone``
+    The same with the real valve's 30 % dead zone (§3): commands below 30 %
+    leave the valve shut. A sensitivity variant, not a reproduction target.
+``thesis-pwm``
+    The same with the time-resolved PWM valve: each valve shut or fully open,
+    16 ms period, delays and 30 % dead zone.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from twin.exceptions import InvalidScenario
+from twin.params import FrictionParams, JointParams, ValveParams
+from twin.valves import ValveModel
+
+
+@dataclasses.dataclass(frozen=True)
+class Plant:
+    name: str
+    params: JointParams
+    valve_model: ValveModel
+    gain_set: str  # "simulation" or "experiment"
+    timestep: float = 1e-3  # s, physics step = sensor tick
+
+
+_THESIS_PARAMS = JointParams(
+    valves=ValveParams(dead_zone_duty=0.0),
+    friction=FrictionParams(stiction=0.0),
+)
+
+PLANTS = {
+    "thesis": Plant("thesis", _THESIS_PARAMS, ValveModel.AVERAGED, "simulation"),
+    "thesis-deadzone": Plant("thesis-deadzone", dataclasses.replace(_THESIS_PARAMS, valves=ValveParams()),
+                             ValveModel.AVERAGED, "simulation"),
+    "thesis-pwm": Plant("thesis-pwm", dataclasses.replace(_THESIS_PARAMS, valves=ValveParams()),
+                        ValveModel.PWM, "simulation"),
+}
+
+
+def plant(name: str) -> Plant:
+    if name not in PLANTS:
+        raise InvalidScenario(f"unknown plant {name!r}: choose one of {', '.join(PLANTS)}")
+    return PLANTS[name]

@@ -1,0 +1,224 @@
+"""The simulation loop: many scenarios stepped together, one step order.
+
+Every 1 ms tick k (t = k h, integer ticks, never a float clock), for all n
+scenarios at once (arrays have a leading scenario axis)::
+
+    MuJoCo state ──► sensors ──► observer ──► controllers ──► valves ──► hydraulics ──► mj_step
+       (qpos)       (Hall y,     (v_hat,      (if due: every   (delays,   (implicit rack   (Batch,
+                     pressures,   a_hat)       16 ms; SMC's     dead zone, step, friction,   all sims)
+                     noise)                    switching 1 ms)  PWM)       forces on racks)
+
+The physics step equals the sensor tick. The hydraulic callback runs in this
+loop, not as a process-global ``mjcb_control``, so two twins in one process
+cannot interfere; it writes only ``ctrl``. Scenarios with different payloads
+or orientations run on their own compiled models in the same batch.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+import time
+from collections.abc import Callable, Sequence
+
+import mujoco
+import mujoco.batch
+import numpy as np
+
+from controllers import make_controller
+from controllers.feedforward import NominalModel
+from twin import hydraulics
+from twin.control import Measurement, Setpoint
+from twin.exceptions import InvalidScenario, SimulationFailed
+from twin.metrics import Metrics, tracking_metrics
+from twin.model import JointModel, Orientation, compile_joint
+from twin.params import JointParams
+from twin.plants import Plant, plant
+from twin.scenario import Scenario
+from twin.sensing import FirstOrderObserver, uniform_noise
+from twin.trajectories import trajectory
+from twin.valves import ValveBank
+
+PROGRESS_EVERY = 250  # ticks between progress callbacks
+
+
+@dataclasses.dataclass(frozen=True)
+class Trace:
+    """Time series of one run, SI units; arrays are (T,) unless noted."""
+
+    time: np.ndarray  # s
+    desired_angle: np.ndarray  # rad
+    angle: np.ndarray  # rad, the output shaft (spur joint)
+    rack_position: np.ndarray  # m, true y
+    measured_position: np.ndarray  # m, Hall sensor
+    duty: np.ndarray  # %, command in force
+    valve_open: np.ndarray  # (T, 4) bool, V1..V4
+    pressure_a: np.ndarray  # Pa
+    pressure_b: np.ndarray  # Pa
+    supply_pressure: np.ndarray  # Pa
+    coupling_error: np.ndarray  # rad, spur angle - y / r_s
+
+
+@dataclasses.dataclass(frozen=True)
+class Result:
+    scenario: Scenario
+    trace: Trace
+    metrics: Metrics
+    warnings: tuple[str, ...]
+    wall_time: float  # s, for the whole batch this run was part of
+
+
+@functools.lru_cache(maxsize=64)
+def _joint(params: JointParams, payload: float, orientation: Orientation, timestep: float) -> JointModel:
+    return compile_joint(params=params, payload_mass=payload, orientation=orientation, timestep=timestep)
+
+
+def _groups(keys: Sequence) -> dict:
+    groups: dict = {}
+    for i, key in enumerate(keys):
+        groups.setdefault(key, []).append(i)
+    return {key: np.array(idx) for key, idx in groups.items()}
+
+
+def _warnings(data: mujoco.MjData) -> tuple[str, ...]:
+    found = []
+    for index in range(int(mujoco.mjtWarning.mjNWARNING)):
+        count = data.warning[index].number
+        if count:
+            found.append(f"{mujoco.mjtWarning(index).name} x{count}")
+    return tuple(found)
+
+
+def simulate(scenarios: Sequence[Scenario], *, progress: Callable[[int, int], None] | None = None,
+             nthread: int = 0) -> list[Result]:
+    """Run every scenario to the end of its trajectory; one :class:`Result` each, in order."""
+    if not scenarios:
+        raise InvalidScenario("no scenarios to simulate")
+    started = time.perf_counter()
+    n = len(scenarios)
+    plants: list[Plant] = [plant(s.plant) for s in scenarios]
+    h = plants[0].timestep
+    if any(p.timestep != h for p in plants):
+        raise InvalidScenario("scenarios in one batch must share the physics timestep")
+    joints = [_joint(p.params, s.payload, s.orientation, p.timestep) for s, p in zip(scenarios, plants)]
+    dof = joints[0]
+    if any((j.rack_a_dof, j.spur_dof) != (dof.rack_a_dof, dof.spur_dof) for j in joints):
+        raise SimulationFailed("joint models disagree on their degrees of freedom")
+
+    batch = mujoco.batch.Batch(joints[0].model, nsim=n, nthread=nthread, persistent=True)
+    if any(j.model is not joints[0].model for j in joints):
+        batch.set_models([j.model for j in joints])
+    qpos, qvel, ctrl = batch.bind("qpos"), batch.bind("qvel"), batch.bind("ctrl")
+    qfrc_bias, qfrc_passive = batch.bind("qfrc_bias"), batch.bind("qfrc_passive")
+
+    spur_radius = np.array([p.params.gears.spur_radius for p in plants])
+    bore_area = np.array([p.params.cylinder.bore_area for p in plants])
+    manifold = np.stack([j.manifold for j in joints])
+    mass = np.array([j.effective_mass for j in joints])
+    supply = np.array([s.supply for s in scenarios])
+
+    trajectories = [trajectory(s.trajectory, spur_radius=r) for s, r in zip(scenarios, spur_radius)]
+    lengths = np.array([int(round(tr.duration / h)) for tr in trajectories])
+    ticks = int(lengths.max())
+    t = np.arange(ticks) * h
+    references = [tr.sample(t, r) for tr, r in zip(trajectories, spur_radius)]
+    y_d = np.stack([ref.position for ref in references])
+    v_d = np.stack([ref.velocity for ref in references])
+    a_d = np.stack([ref.acceleration for ref in references])
+
+    position_noise = np.zeros((n, ticks))
+    pressure_noise = np.zeros((n, ticks, 3))
+    for i, (s, p) in enumerate(zip(scenarios, plants)):
+        if s.noise:
+            rng = np.random.default_rng(s.seed)
+            position_noise[i, :lengths[i]] = uniform_noise(rng, p.params.sensors.position_noise, (lengths[i],))
+            pressure_noise[i, :lengths[i]] = uniform_noise(rng, p.params.sensors.pressure_noise, (lengths[i], 3))
+
+    y0 = y_d[:, 0]
+    qpos[:, dof.rack_a_dof] = y0
+    qpos[:, dof.rack_b_dof] = -y0
+    qpos[:, dof.pinion_dof] = -y0 / np.array([p.params.gears.pinion_radius for p in plants])
+    qpos[:, dof.spur_dof] = y0 / spur_radius
+    qvel[:] = 0.0
+    batch.forward()
+
+    controller_groups = []
+    for (name, gain_set, nominal), idx in _groups(
+            [(s.controller, p.gain_set, NominalModel.thesis(p.params)) for s, p in zip(scenarios, plants)]).items():
+        controller = make_controller(name, nominal=nominal, gain_set=gain_set, tick=h)
+        controller.reset(len(idx))
+        every = int(round(controller.period / h))
+        controller_groups.append((controller, idx, every))
+    plant_groups = []
+    for name, idx in _groups([s.plant for s in scenarios]).items():
+        preset = plant(name)
+        bank = ValveBank(params=preset.params.valves, model=preset.valve_model, n=len(idx), tick=h)
+        plant_groups.append((preset, idx, bank))
+
+    observer = FirstOrderObserver(params=plants[0].params.observer, sample_period=h, initial=y0 + position_noise[:, 0])
+    duty = np.zeros(n)
+    conductance = np.zeros((n, 4))
+    stuck = np.ones(n, dtype=bool)
+    pressure_a = np.zeros(n)
+    pressure_b = np.zeros(n)
+    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps")}
+    valve_open = np.zeros((n, ticks, 4), dtype=bool)
+
+    for k in range(ticks):
+        y = qpos[:, dof.rack_a_dof].copy()
+        v = qvel[:, dof.rack_a_dof].copy()
+        y_measured = y + position_noise[:, k]
+        v_hat, a_hat = observer.update(y_measured)
+        supply_measured = supply + pressure_noise[:, k, 2]
+        for controller, idx, every in controller_groups:
+            if k % every == 0:
+                measurement = Measurement(position=y_measured[idx], velocity=v_hat[idx],
+                                          acceleration=a_hat[idx], supply_pressure=supply_measured[idx])
+                setpoint = Setpoint(position=y_d[idx, k], velocity=v_d[idx, k], acceleration=a_d[idx, k])
+                duty[idx] = controller.update(k * h, measurement, setpoint)
+        external = np.einsum("ij,ij->i", qfrc_passive - qfrc_bias, manifold)
+        for preset, idx, bank in plant_groups:
+            conductance[idx] = bank.update(k, duty[idx])
+            circuit = hydraulics.circuit(conductance[idx], supply[idx], preset.params.cylinder.bore_area)
+            forces = hydraulics.rack_step(
+                circuit_now=circuit, friction_params=preset.params.friction,
+                bore_area=preset.params.cylinder.bore_area, y=y[idx], v0=v[idx],
+                external_force=external[idx], stuck=stuck[idx], mass=mass[idx], h=h)
+            ctrl[idx, 0] = forces.net_force
+            stuck[idx] = forces.stuck
+            pressure_a[idx], pressure_b[idx] = forces.pressure_a, forces.pressure_b
+        rec["y"][:, k] = y
+        rec["ym"][:, k] = y_measured
+        rec["theta"][:, k] = qpos[:, dof.spur_dof]
+        rec["duty"][:, k] = duty
+        rec["pa"][:, k] = pressure_a
+        rec["pb"][:, k] = pressure_b
+        rec["ps"][:, k] = supply
+        valve_open[:, k] = conductance > 0
+        batch.step()
+        if progress is not None and (k % PROGRESS_EVERY == 0 or k == ticks - 1):
+            progress(k + 1, ticks)
+
+    wall = time.perf_counter() - started
+    results = []
+    for i, s in enumerate(scenarios):
+        T = lengths[i]
+        theta = rec["theta"][i, :T]
+        desired = y_d[i, :T] / spur_radius[i]
+        warnings = _warnings(batch.get_data(i))
+        if not np.all(np.isfinite(theta)):
+            warnings += ("state is not finite",)
+        trace = Trace(
+            time=t[:T], desired_angle=desired, angle=theta, rack_position=rec["y"][i, :T],
+            measured_position=rec["ym"][i, :T], duty=rec["duty"][i, :T], valve_open=valve_open[i, :T],
+            pressure_a=rec["pa"][i, :T], pressure_b=rec["pb"][i, :T], supply_pressure=rec["ps"][i, :T],
+            coupling_error=theta - rec["y"][i, :T] / spur_radius[i],
+        )
+        results.append(Result(scenario=s, trace=trace, metrics=tracking_metrics(desired, theta),
+                              warnings=warnings, wall_time=wall))
+    return results
+
+
+def run(scenario: Scenario, **kwargs) -> Result:
+    """One scenario; the case n = 1 of :func:`simulate`."""
+    return simulate([scenario], **kwargs)[0]

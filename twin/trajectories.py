@@ -1,0 +1,122 @@
+"""The four test trajectories of §7, as rack position references.
+
+Angles are the output angle theta = y / r_s. Start angles and holds that the
+thesis does not state are chosen inside the friction fit's range
+(y = 2 - 14.5 mm, i.e. 24 - 174 deg) and written down here:
+
+==  =======  =========  ==========================================================
+#   start    duration   shape
+==  =======  =========  ==========================================================
+T1  20 deg   3.0 s      +120 deg cycloid in 1 s, hold 2 s
+T2  20 deg   2.0 s      ramp at 10 mm/s rack speed to 140 deg (0.998 s), hold to 2 s
+T3  80 deg   4.0 s      80 + 60 sin(pi t) deg: 0.5 Hz, 20 - 140 deg, two periods,
+                        starting mid-stroke at full speed (the thesis reports its
+                        largest error at the start of T3)
+T4  20 deg   6.0 s      +120 (1 s), rest 1, -120 (1 s), rest 0.5, +60 (0.5 s),
+                        rest 0.5, -60 (0.5 s), rest 1
+==  =======  =========  ==========================================================
+
+The cycloidal rise (eqs. 5.2.5 - 5.2.7) of height H over T:
+``y = H (t/T - sin(2 pi t/T) / (2 pi))``, so ``a = A_max sin(2 pi t/T)`` with
+``A_max = 2 pi H / T^2``.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from twin.exceptions import InvalidScenario
+
+RAMP_SPEED = 10e-3  # m/s, T2's rack speed (§7)
+
+
+@dataclasses.dataclass(frozen=True)
+class Reference:
+    """Desired rack motion sampled at ticks; arrays are (T,)."""
+
+    position: np.ndarray  # m
+    velocity: np.ndarray  # m/s
+    acceleration: np.ndarray  # m/s^2
+
+
+@dataclasses.dataclass(frozen=True)
+class Segment:
+    kind: str  # "cycloid" or "rest" or "ramp" or "sine"
+    duration: float  # s
+    delta: float = 0.0  # rad of output angle (cycloid, ramp)
+
+
+@dataclasses.dataclass(frozen=True)
+class Trajectory:
+    number: int
+    start: float  # rad
+    segments: tuple[Segment, ...]
+
+    @property
+    def duration(self) -> float:
+        return sum(s.duration for s in self.segments)  # s
+
+    def sample(self, t: np.ndarray, spur_radius: float) -> Reference:
+        """The reference at times ``t`` (s), as rack motion (y = theta r_s)."""
+        theta = np.full_like(t, self.start)
+        omega = np.zeros_like(t)
+        alpha = np.zeros_like(t)
+        begin, level = 0.0, self.start
+        for seg in self.segments:
+            local = t - begin
+            inside = (local >= 0) & (local < seg.duration)
+            after = local >= seg.duration
+            if seg.kind == "cycloid":
+                tau = 2.0 * math.pi / seg.duration
+                theta = np.where(inside, level + seg.delta * (local / seg.duration - np.sin(tau * local) / (2 * math.pi)), theta)
+                omega = np.where(inside, seg.delta / seg.duration * (1.0 - np.cos(tau * local)), omega)
+                alpha = np.where(inside, seg.delta / seg.duration * tau * np.sin(tau * local), alpha)
+            elif seg.kind == "ramp":
+                rate = seg.delta / seg.duration
+                theta = np.where(inside, level + rate * local, theta)
+                omega = np.where(inside, rate, omega)
+            elif seg.kind == "sine":  # amplitude in delta, 0.5 Hz, about the start level
+                w = math.pi
+                theta = np.where(inside, level + seg.delta * np.sin(w * local), theta)
+                omega = np.where(inside, seg.delta * w * np.cos(w * local), omega)
+                alpha = np.where(inside, -seg.delta * w * w * np.sin(w * local), alpha)
+            end_level = level + (seg.delta if seg.kind in ("cycloid", "ramp") else 0.0)
+            if seg.kind == "sine":
+                end_level = level + seg.delta * math.sin(math.pi * seg.duration)
+            theta = np.where(after, end_level, theta)
+            omega = np.where(after, 0.0, omega)
+            alpha = np.where(after, 0.0, alpha)
+            begin, level = begin + seg.duration, end_level
+        return Reference(position=theta * spur_radius, velocity=omega * spur_radius,
+                         acceleration=alpha * spur_radius)
+
+
+def _deg(x: float) -> float:
+    return math.radians(x)
+
+
+def _t2(spur_radius: float) -> Trajectory:
+    rise = _deg(120.0)
+    ramp_time = rise * spur_radius / RAMP_SPEED
+    return Trajectory(2, _deg(20.0), (Segment("ramp", ramp_time, rise), Segment("rest", 2.0 - ramp_time)))
+
+
+def trajectory(number: int, *, spur_radius: float) -> Trajectory:
+    """T1..T4 of §7."""
+    if number == 1:
+        return Trajectory(1, _deg(20.0), (Segment("cycloid", 1.0, _deg(120.0)), Segment("rest", 2.0)))
+    if number == 2:
+        return _t2(spur_radius)
+    if number == 3:
+        return Trajectory(3, _deg(80.0), (Segment("sine", 4.0, _deg(60.0)),))
+    if number == 4:
+        return Trajectory(4, _deg(20.0), (
+            Segment("cycloid", 1.0, _deg(120.0)), Segment("rest", 1.0),
+            Segment("cycloid", 1.0, _deg(-120.0)), Segment("rest", 0.5),
+            Segment("cycloid", 0.5, _deg(60.0)), Segment("rest", 0.5),
+            Segment("cycloid", 0.5, _deg(-60.0)), Segment("rest", 1.0),
+        ))
+    raise InvalidScenario(f"unknown trajectory {number!r}: choose 1, 2, 3 or 4")

@@ -1,0 +1,100 @@
+"""The four solenoid valves: from a signed duty command to flow conductances.
+
+V1 supplies cylinder A, V2 drains A, V3 supplies B, V4 drains B (§3). A
+command ``u > 0`` (percent) opens the pair V1 + V4 (rack A extends, theta
+grows), ``u < 0`` the pair V3 + V2. The supply valve of the pair is fully on;
+only the discharge valve is modulated. ``|u|`` above 100 % is clipped to 100 %
+(a valve cannot be more than always open).
+
+Two named valve models, both with the opening and closing delays of §3:
+
+``averaged`` (the thesis's model)
+    The discharge valve is a steady resistance R(|u|) of eq. 4.4.2 for the
+    whole PWM period: the PWM is averaged out. Commands with |u| below
+    ``dead_zone_duty`` leave the valve shut.
+``pwm`` (time-resolved)
+    Each valve is either shut or fully open (R(100 %)); the discharge valve's
+    coil is on for the first |u| x period of each period. A pulse shorter than
+    ``dead_zone_duty`` x period is not sent: the real valve does not open (§3).
+
+Delays act on the coil signal: a valve opens ``opening_delay`` after its coil
+turns on and shuts ``closing_delay`` after it turns off, so a coil pulse
+shorter than the difference never opens the valve::
+
+    open[k] = coil[k - n_open]  and  coil[k - n_close]
+"""
+
+from __future__ import annotations
+
+import enum
+
+import numpy as np
+
+from twin.exceptions import InvalidScenario
+from twin.params import ValveParams
+
+SUPPLY_A, DRAIN_A, SUPPLY_B, DRAIN_B = range(4)  # V1, V2, V3, V4
+
+
+class ValveModel(enum.Enum):
+    AVERAGED = "averaged"
+    PWM = "pwm"
+
+
+def _ticks(duration: float, tick: float) -> int:
+    ticks = duration / tick
+    if abs(ticks - round(ticks)) > 1e-9:
+        raise InvalidScenario(f"{duration} s is not a whole number of {tick} s ticks")
+    return int(round(ticks))
+
+
+class ValveBank:
+    """Four valves for each of ``n`` scenarios; call :meth:`update` once per tick.
+
+    State: the coil conductance history (n, 4, n_open + 1) in m^3/(Pa s).
+    """
+
+    def __init__(self, *, params: ValveParams, model: ValveModel, n: int, tick: float):
+        self.params = params
+        self.model = model
+        self.n = n
+        self.period_ticks = _ticks(params.pwm_period, tick)
+        self.open_ticks = _ticks(params.opening_delay, tick)
+        self.close_ticks = _ticks(params.closing_delay, tick)
+        if self.close_ticks > self.open_ticks:
+            raise InvalidScenario("closing delay longer than opening delay is not modelled")
+        self.full_conductance = 1.0 / params.open_resistance
+        self._coil = np.zeros((n, 4, self.open_ticks + 1))
+        self._head = 0
+
+    def reset(self) -> None:
+        self._coil[:] = 0.0
+        self._head = 0
+
+    def _coil_conductance(self, tick: int, duty: np.ndarray) -> np.ndarray:
+        """Conductance each valve would have with no delay, (n, 4)."""
+        magnitude = np.minimum(np.abs(duty), 100.0)
+        energised = magnitude >= max(self.params.dead_zone_duty, 1e-9)
+        if self.model is ValveModel.AVERAGED:
+            drain = np.where(energised, 1.0 / self.params.resistance(np.maximum(magnitude, 1e-9)), 0.0)
+        else:
+            on_ticks = np.rint(magnitude / 100.0 * self.period_ticks)
+            in_pulse = (tick % self.period_ticks) < on_ticks
+            drain = np.where(energised & in_pulse, self.full_conductance, 0.0)
+        supply = np.where(energised, self.full_conductance, 0.0)
+        forward, backward = duty > 0, duty < 0
+        coil = np.zeros((self.n, 4))
+        coil[:, SUPPLY_A] = np.where(forward, supply, 0.0)
+        coil[:, DRAIN_B] = np.where(forward, drain, 0.0)
+        coil[:, SUPPLY_B] = np.where(backward, supply, 0.0)
+        coil[:, DRAIN_A] = np.where(backward, drain, 0.0)
+        return coil
+
+    def update(self, tick: int, duty: np.ndarray) -> np.ndarray:
+        """Valve conductances (n, 4) in m^3/(Pa s) at integer ``tick`` for signed ``duty`` (n,) in %."""
+        depth = self.open_ticks + 1
+        self._head = (self._head + 1) % depth
+        self._coil[:, :, self._head] = self._coil_conductance(tick, duty)
+        opened = self._coil[:, :, (self._head - self.open_ticks) % depth]
+        still_on = self._coil[:, :, (self._head - self.close_ticks) % depth] > 0.0
+        return np.where(still_on, opened, 0.0)
