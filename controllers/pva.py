@@ -17,6 +17,7 @@ import numpy as np
 
 from twin.control import Measurement, Setpoint
 from twin.exceptions import InvalidController
+from twin.ticks import whole_ticks
 
 PWM_PERIOD = 16e-3  # s, the controller runs once per PWM period (§6)
 
@@ -41,10 +42,7 @@ def pva_duty(gains: PVAGains, measurement: Measurement, setpoint: Setpoint) -> n
 
 def check_period(period: float, tick: float) -> int:
     """Ticks per update; rejects a period that is not a whole number of ticks."""
-    ticks = period / tick
-    if period <= 0 or abs(ticks - round(ticks)) > 1e-9:
-        raise InvalidController(f"controller period {period} s is not a whole number of {tick} s ticks")
-    return int(round(ticks))
+    return whole_ticks(period, tick, what="controller period", error=InvalidController)
 
 
 @dataclasses.dataclass

@@ -7,7 +7,7 @@ import math
 
 from twin.exceptions import InvalidScenario
 from twin.model import MAX_PAYLOAD, Orientation
-from twin.plants import plant
+from twin.plants import Plant, plant
 
 CONTROLLER_NAMES = ("pva", "ffpva", "smc")
 TRAJECTORY_NUMBERS = (1, 2, 3, 4)
@@ -19,7 +19,7 @@ class Scenario:
     trajectory: int  # 1..4
     payload: float = 0.0  # kg at the link tip
     orientation: Orientation = Orientation.HORIZONTAL
-    plant: str = "thesis"
+    plant: str | Plant = "thesis"  # a preset name, or a Plant for what-ifs and tests
     seed: int = 0
     noise: bool = True  # the thesis's sensor noise (§5)
     supply_pressure: float | None = None  # Pa gauge; None: the plant's
@@ -33,7 +33,7 @@ class Scenario:
             raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, got {self.payload!r} kg")
         if not isinstance(self.orientation, Orientation):
             raise InvalidScenario(f"orientation must be an Orientation, got {self.orientation!r}")
-        preset = plant(self.plant)
+        preset = self.preset
         if not isinstance(self.seed, int) or self.seed < 0:
             raise InvalidScenario(f"seed must be a non-negative integer, got {self.seed!r}")
         if self.supply_pressure is not None:
@@ -44,8 +44,16 @@ class Scenario:
                     f"got {self.supply_pressure / 1e3:g} kPa")
 
     @property
+    def preset(self) -> Plant:
+        return self.plant if isinstance(self.plant, Plant) else plant(self.plant)
+
+    @property
+    def plant_name(self) -> str:
+        return self.preset.name
+
+    @property
     def supply(self) -> float:
         """Supply pressure in Pa."""
         if self.supply_pressure is not None:
             return self.supply_pressure
-        return plant(self.plant).params.supply.pressure
+        return self.preset.params.supply.pressure

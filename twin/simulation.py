@@ -25,17 +25,16 @@ import mujoco
 import mujoco.batch
 import numpy as np
 
-from controllers import make_controller
-from controllers.feedforward import NominalModel
 from twin import hydraulics
-from twin.control import Measurement, Setpoint
+from twin.control import Controller, Measurement, Setpoint
 from twin.exceptions import InvalidScenario, SimulationFailed
 from twin.metrics import Metrics, tracking_metrics
 from twin.model import JointModel, Orientation, compile_joint
 from twin.params import JointParams
-from twin.plants import Plant, plant
+from twin.plants import Plant
 from twin.scenario import Scenario
 from twin.sensing import FirstOrderObserver, uniform_noise
+from twin.ticks import whole_ticks
 from twin.trajectories import trajectory
 from twin.valves import ValveBank
 
@@ -89,14 +88,20 @@ def _warnings(data: mujoco.MjData) -> tuple[str, ...]:
     return tuple(found)
 
 
-def simulate(scenarios: Sequence[Scenario], *, progress: Callable[[int, int], None] | None = None,
-             nthread: int = 0) -> list[Result]:
-    """Run every scenario to the end of its trajectory; one :class:`Result` each, in order."""
+def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller],
+             progress: Callable[[int, int], None] | None = None, nthread: int = 0) -> list[Result]:
+    """Run every scenario to the end of its trajectory; one :class:`Result` each, in order.
+
+    ``controllers[i]`` drives scenario i; scenarios that share one controller
+    instance are driven by it together, vectorised (its arrays are in the order
+    of those scenarios). ``twin.runner`` builds them from the scenarios' names.
+    ``progress(done_ticks, total_ticks)`` is called as the batch advances.
+    """
     if not scenarios:
         raise InvalidScenario("no scenarios to simulate")
     started = time.perf_counter()
     n = len(scenarios)
-    plants: list[Plant] = [plant(s.plant) for s in scenarios]
+    plants: list[Plant] = [s.preset for s in scenarios]
     h = plants[0].timestep
     if any(p.timestep != h for p in plants):
         raise InvalidScenario("scenarios in one batch must share the physics timestep")
@@ -142,16 +147,15 @@ def simulate(scenarios: Sequence[Scenario], *, progress: Callable[[int, int], No
     qvel[:] = 0.0
     batch.forward()
 
+    if len(controllers) != n:
+        raise InvalidScenario(f"{len(controllers)} controllers for {n} scenarios")
     controller_groups = []
-    for (name, gain_set, nominal), idx in _groups(
-            [(s.controller, p.gain_set, NominalModel.thesis(p.params)) for s, p in zip(scenarios, plants)]).items():
-        controller = make_controller(name, nominal=nominal, gain_set=gain_set, tick=h)
+    for _, idx in _groups([id(c) for c in controllers]).items():
+        controller = controllers[idx[0]]
         controller.reset(len(idx))
-        every = int(round(controller.period / h))
-        controller_groups.append((controller, idx, every))
+        controller_groups.append((controller, idx, whole_ticks(controller.period, h, what="controller period")))
     plant_groups = []
-    for name, idx in _groups([s.plant for s in scenarios]).items():
-        preset = plant(name)
+    for preset, idx in _groups(plants).items():
         bank = ValveBank(params=preset.params.valves, model=preset.valve_model, n=len(idx), tick=h)
         plant_groups.append((preset, idx, bank))
 
@@ -217,8 +221,3 @@ def simulate(scenarios: Sequence[Scenario], *, progress: Callable[[int, int], No
         results.append(Result(scenario=s, trace=trace, metrics=tracking_metrics(desired, theta),
                               warnings=warnings, wall_time=wall))
     return results
-
-
-def run(scenario: Scenario, **kwargs) -> Result:
-    """One scenario; the case n = 1 of :func:`simulate`."""
-    return simulate([scenario], **kwargs)[0]

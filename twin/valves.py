@@ -32,6 +32,7 @@ import numpy as np
 
 from twin.exceptions import InvalidScenario
 from twin.params import ValveParams
+from twin.ticks import whole_ticks
 
 SUPPLY_A, DRAIN_A, SUPPLY_B, DRAIN_B = range(4)  # V1, V2, V3, V4
 
@@ -39,13 +40,6 @@ SUPPLY_A, DRAIN_A, SUPPLY_B, DRAIN_B = range(4)  # V1, V2, V3, V4
 class ValveModel(enum.Enum):
     AVERAGED = "averaged"
     PWM = "pwm"
-
-
-def _ticks(duration: float, tick: float) -> int:
-    ticks = duration / tick
-    if abs(ticks - round(ticks)) > 1e-9:
-        raise InvalidScenario(f"{duration} s is not a whole number of {tick} s ticks")
-    return int(round(ticks))
 
 
 class ValveBank:
@@ -58,9 +52,11 @@ class ValveBank:
         self.params = params
         self.model = model
         self.n = n
-        self.period_ticks = _ticks(params.pwm_period, tick)
-        self.open_ticks = _ticks(params.opening_delay, tick)
-        self.close_ticks = _ticks(params.closing_delay, tick)
+        self.period_ticks = whole_ticks(params.pwm_period, tick, what="PWM period")
+        self.open_ticks = round(params.opening_delay / tick)
+        self.close_ticks = round(params.closing_delay / tick)
+        if abs(self.open_ticks * tick - params.opening_delay) > 1e-12 or abs(self.close_ticks * tick - params.closing_delay) > 1e-12:
+            raise InvalidScenario("valve delays must be whole numbers of ticks")
         if self.close_ticks > self.open_ticks:
             raise InvalidScenario("closing delay longer than opening delay is not modelled")
         self.full_conductance = 1.0 / params.open_resistance
@@ -74,11 +70,13 @@ class ValveBank:
     def _coil_conductance(self, tick: int, duty: np.ndarray) -> np.ndarray:
         """Conductance each valve would have with no delay, (n, 4)."""
         magnitude = np.minimum(np.abs(duty), 100.0)
-        energised = magnitude >= max(self.params.dead_zone_duty, 1e-9)
+        # The coil switches only on tick boundaries: a period of P ticks realises duties in 100/P % steps.
+        on_ticks = np.rint(magnitude / 100.0 * self.period_ticks)
+        realised = on_ticks * (100.0 / self.period_ticks)
+        energised = (on_ticks > 0) & (magnitude >= self.params.dead_zone_duty)
         if self.model is ValveModel.AVERAGED:
-            drain = np.where(energised, 1.0 / self.params.resistance(np.maximum(magnitude, 1e-9)), 0.0)
+            drain = np.where(energised, 1.0 / self.params.resistance(np.maximum(realised, 1e-9)), 0.0)
         else:
-            on_ticks = np.rint(magnitude / 100.0 * self.period_ticks)
             in_pulse = (tick % self.period_ticks) < on_ticks
             drain = np.where(energised & in_pulse, self.full_conductance, 0.0)
         supply = np.where(energised, self.full_conductance, 0.0)

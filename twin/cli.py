@@ -1,0 +1,149 @@
+"""Command line of the hydraulic joint twin.
+
+    twin demo                      reproduce the thesis's controller comparison
+    twin run --controller ffpva --trajectory 1 --json      one scenario
+
+Degrees, grams and kPa here; SI inside. Bad input gets a one-line error and
+exit code 2, and nothing is written.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import pathlib
+import sys
+
+from twin.exceptions import TwinError
+from twin.model import Orientation
+from twin.plants import PLANTS
+from twin.scenario import CONTROLLER_NAMES, Scenario
+
+EXIT_USAGE = 2
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, no usage dump
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+
+
+def _writable_file(text: str) -> pathlib.Path:
+    path = pathlib.Path(text)
+    if not path.parent.exists():
+        raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
+    if path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+    return path
+
+
+def _grams(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"payload must be a number of grams, got {text!r}") from None
+    if not math.isfinite(value) or value < 0:
+        raise argparse.ArgumentTypeError(f"payload must be a non-negative number of grams, got {text!r}")
+    return value
+
+
+def _kpa(text: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"supply pressure must be a number of kPa, got {text!r}") from None
+    if not math.isfinite(value) or not 0 < value <= 700:
+        raise argparse.ArgumentTypeError(f"supply pressure must be in (0, 700] kPa (cylinder rating), got {text!r}")
+    return value
+
+
+def _seed(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"seed must be a non-negative integer, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"seed must be a non-negative integer, got {text!r}")
+    return value
+
+
+def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
+    """The scenario flags shared by ``run`` and later commands."""
+    parser.add_argument("--controller", choices=CONTROLLER_NAMES, required=True)
+    parser.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), required=True)
+    parser.add_argument("--payload", type=_grams, default=0.0, metavar="GRAMS", help="mass at the link tip (g)")
+    parser.add_argument("--orientation", choices=[o.value for o in Orientation], default="horizontal")
+    parser.add_argument("--plant", choices=sorted(PLANTS), default="thesis")
+    parser.add_argument("--seed", type=_seed, default=0)
+    parser.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
+                        help="the thesis's sensor noise, seeded (default on)")
+    parser.add_argument("--supply-kpa", type=_kpa, default=None, help="supply pressure (kPa gauge)")
+
+
+def scenario_from(args: argparse.Namespace) -> Scenario:
+    return Scenario(
+        controller=args.controller, trajectory=args.trajectory, payload=args.payload / 1e3,
+        orientation=Orientation(args.orientation), plant=args.plant, seed=args.seed, noise=args.noise,
+        supply_pressure=None if args.supply_kpa is None else args.supply_kpa * 1e3,
+    )
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from twin import report
+    from twin.runner import run
+
+    result = run(scenario_from(args))
+    if args.trace:
+        report.write_trace(result, args.trace)
+    if args.plot:
+        from viz.plots import plot_run
+
+        plot_run(result, args.plot)
+    record = report.summary(result)
+    if args.json:
+        print(json.dumps(record))
+    else:
+        print(f"RMSE {record['rmse_deg']:.3f} deg  SSE {record['sse_deg']:.3f} deg  "
+              f"max |e| {record['max_error_deg']:.3f} deg  ({record['duration_s']:.2f} s simulated)")
+        for warning in record["warnings"]:
+            print(f"warning: {warning}")
+    return 1 if result.warnings else 0
+
+
+def _cmd_demo(args: argparse.Namespace) -> int:
+    from twin.demo import run_demo
+
+    return run_demo(out=args.out, seeds=args.seeds, plots=args.plots)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="twin", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+
+    demo = sub.add_parser("demo", help="reproduce the thesis's simulated controller comparison")
+    demo.add_argument("--out", type=pathlib.Path, default=pathlib.Path("twin-demo"),
+                      help="output folder (created; default ./twin-demo)")
+    demo.add_argument("--seeds", type=int, default=5, help="noise seeds per case (default 5)")
+    demo.add_argument("--plots", action=argparse.BooleanOptionalAction, default=True)
+    demo.set_defaults(func=_cmd_demo)
+
+    run = sub.add_parser("run", help="simulate one scenario")
+    add_scenario_arguments(run)
+    run.add_argument("--trace", type=_writable_file, metavar="FILE.csv", help="write the time series")
+    run.add_argument("--plot", type=_writable_file, metavar="FILE.png", help="write a figure")
+    run.add_argument("--json", action="store_true", help="print exactly one JSON object")
+    run.set_defaults(func=_cmd_run)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except TwinError as error:
+        print(f"twin: error: {error}", file=sys.stderr)
+        return EXIT_USAGE
+
+
+if __name__ == "__main__":
+    sys.exit(main())

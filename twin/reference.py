@@ -1,0 +1,17 @@
+"""The thesis's published results (SPEC §8), in degrees, for comparison tables."""
+
+from __future__ import annotations
+
+# Simulated RMSE per trajectory T1..T4 and SSE of T1 (§8, "Simulation").
+THESIS_SIMULATED_RMSE_DEG = {
+    "ffpva": {1: 0.52, 2: 0.83, 3: 0.91, 4: 0.80},
+    "smc": {1: 0.86, 2: 0.99, 3: 1.26, 4: 0.94},
+}
+THESIS_SIMULATED_SSE_T1_DEG = {"ffpva": 0.35, "smc": 0.53}
+
+# Experiment, horizontal, no payload: mean RMSE and std over 5 runs (§8).
+THESIS_EXPERIMENT_RMSE_DEG = {
+    "pva": {1: (4.20, 0.76), 2: (2.93, 0.65), 3: (3.00, 0.50)},
+    "ffpva": {1: (1.40, 0.06), 2: (2.08, 0.21), 3: (2.09, 0.12), 4: (1.95, 0.16)},
+    "smc": {1: (1.19, 0.11), 2: (1.55, 0.25), 3: (1.69, 0.09), 4: (1.82, 0.17)},
+}

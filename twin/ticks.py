@@ -1,0 +1,14 @@
+"""Integer tick counting: every period in the twin is a whole number of physics ticks."""
+
+from __future__ import annotations
+
+from twin.exceptions import InvalidScenario, TwinError
+
+
+def whole_ticks(duration: float, tick: float, *, what: str = "period",
+                error: type[TwinError] = InvalidScenario) -> int:
+    """``duration / tick`` as an int, or ``error`` if it is not a positive whole number."""
+    ticks = duration / tick
+    if duration <= 0 or abs(ticks - round(ticks)) > 1e-9:
+        raise error(f"{what} of {duration} s is not a whole number of {tick} s ticks")
+    return int(round(ticks))
