@@ -26,15 +26,12 @@ step h, with Coulomb friction and stiction as a velocity-level complementarity
 
     v1 = (v0 + h (F_0 + F_ext + F_f) / M) / (1 + h (c_h + F_v) / M)
 
-The resulting *bounded* net force is applied through the ``train`` tendon of
-models/joint.xml, which spreads it over the four joints in proportion to their
-inertia, so the gear train accelerates rigidly within each step. Two simpler
-ways fail (measured): MuJoCo damping on rack A is integrated implicitly on that
-joint alone, after the constraint solve, tearing the couplings apart; and the
-same force applied at rack A only must reach the payload through the soft
-(2 ms) gear constraints, so with 13.5 g at the tip (train inertia 785 g
-referred to the rack, 49x rack A's) the one-step stopping force overshoots and
-diverges.
+The resulting *bounded* forces act where they do on the real joint: each
+piston pushes its rack with its chamber pressure times the bore area (half the
+force loss each), and the gear couplings carry the loads to the output, so
+their constraint forces are the tooth loads. Putting c into MuJoCo as damping
+on rack A instead would not work: ``implicitfast`` applies it to that joint
+alone after the constraint solve and tears the couplings apart.
 """
 
 from __future__ import annotations
@@ -80,7 +77,8 @@ def circuit(conductances: np.ndarray, supply_pressure: np.ndarray, bore_area: fl
 class RackForces:
     """One implicit step of the rack; arrays are (n,)."""
 
-    net_force: np.ndarray  # N along +y: A (P_a - P_b) + force loss
+    cylinder_a: np.ndarray  # N, piston A on rack A, towards +y
+    cylinder_b: np.ndarray  # N, piston B on rack B, towards -y
     pressure_a: np.ndarray  # Pa
     pressure_b: np.ndarray  # Pa
     velocity: np.ndarray  # m/s, rack velocity at the end of the step
@@ -122,6 +120,7 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
 
     loss = dry - friction_params.viscous * v1
     return RackForces(
-        net_force=hydraulic + loss,
+        cylinder_a=bore_area * pressure_a + 0.5 * loss,
+        cylinder_b=bore_area * pressure_b - 0.5 * loss,
         pressure_a=pressure_a, pressure_b=pressure_b, velocity=v1, force_loss=loss, stuck=sticks,
     )

@@ -136,11 +136,6 @@ def compile_joint(*, params: JointParams = JointParams(), payload_mass: float = 
     if np.count_nonzero(inertia - np.diag(np.diag(inertia))):
         raise InvalidScenario("the mechanism's joint-space inertia must be diagonal (one joint per body)")
     effective_mass = float(manifold @ inertia @ manifold)
-    train = root.find("tendon", "train")
-    for element in train.joint:
-        dof = dofs[MECHANISM_JOINTS.index(element.joint.name)]
-        element.coef = inertia[dof, dof] * manifold[dof] / effective_mass
-    model = mujoco.MjModel.from_xml_string(root.to_xml_string(), root.get_assets())
     return JointModel(
         model=model, params=params, payload_mass=payload_mass, orientation=orientation,
         rack_a_dof=dofs[0], rack_b_dof=dofs[1], pinion_dof=dofs[2], spur_dof=dofs[3],

@@ -83,7 +83,7 @@ class MassParams:
 
     def __post_init__(self) -> None:
         _require_positive(self, "rack_mass", "piston_mass", "water_mass", "pinion_inertia",
-                          "spur_inertia", "link_mass", "link_length", "thesis_total_mass")
+                          "spur_inertia", "link_mass", "link_length", "thesis_total_mass", "payload_density")
 
     @property
     def rack_side_mass(self) -> float:

@@ -188,7 +188,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
                 circuit_now=circuit, friction_params=preset.params.friction,
                 bore_area=preset.params.cylinder.bore_area, y=y[idx], v0=v[idx],
                 external_force=external[idx], stuck=stuck[idx], mass=mass[idx], h=h)
-            ctrl[idx, 0] = forces.net_force
+            ctrl[idx, 0] = forces.cylinder_a
+            ctrl[idx, 1] = forces.cylinder_b
             stuck[idx] = forces.stuck
             pressure_a[idx], pressure_b[idx] = forces.pressure_a, forces.pressure_b
         rec["y"][:, k] = y

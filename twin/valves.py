@@ -17,11 +17,12 @@ Two named valve models, both with the opening and closing delays of §3:
     coil is on for the first |u| x period of each period. A pulse shorter than
     ``dead_zone_duty`` x period is not sent: the real valve does not open (§3).
 
-Delays act on the coil signal: a valve opens ``opening_delay`` after its coil
-turns on and shuts ``closing_delay`` after it turns off, so a coil pulse
-shorter than the difference never opens the valve::
-
-    open[k] = coil[k - n_open]  and  coil[k - n_close]
+Delays act on the coil signal: a shut valve opens once its coil has been on
+for ``opening_delay``, an open valve shuts once its coil has been off for
+``closing_delay`` (a state machine per valve). So a coil pulse shorter than the
+opening delay never opens the valve, and a gap shorter than the closing delay
+never shuts it (>= 7 ms per on/off cycle, §3). While open, a valve has the
+conductance of its coil's latest command.
 """
 
 from __future__ import annotations
@@ -57,15 +58,17 @@ class ValveBank:
         self.close_ticks = round(params.closing_delay / tick)
         if abs(self.open_ticks * tick - params.opening_delay) > 1e-12 or abs(self.close_ticks * tick - params.closing_delay) > 1e-12:
             raise InvalidScenario("valve delays must be whole numbers of ticks")
-        if self.close_ticks > self.open_ticks:
-            raise InvalidScenario("closing delay longer than opening delay is not modelled")
         self.full_conductance = 1.0 / params.open_resistance
-        self._coil = np.zeros((n, 4, self.open_ticks + 1))
-        self._head = 0
+        self._on_run = np.zeros((n, 4), dtype=np.int64)  # ticks the coil has been on, this one included
+        self._off_run = np.full((n, 4), 1 << 30, dtype=np.int64)
+        self._open = np.zeros((n, 4), dtype=bool)
+        self._conductance = np.zeros((n, 4))
 
     def reset(self) -> None:
-        self._coil[:] = 0.0
-        self._head = 0
+        self._on_run[:] = 0
+        self._off_run[:] = 1 << 30
+        self._open[:] = False
+        self._conductance[:] = 0.0
 
     def _coil_conductance(self, tick: int, duty: np.ndarray) -> np.ndarray:
         """Conductance each valve would have with no delay, (n, 4)."""
@@ -90,9 +93,12 @@ class ValveBank:
 
     def update(self, tick: int, duty: np.ndarray) -> np.ndarray:
         """Valve conductances (n, 4) in m^3/(Pa s) at integer ``tick`` for signed ``duty`` (n,) in %."""
-        depth = self.open_ticks + 1
-        self._head = (self._head + 1) % depth
-        self._coil[:, :, self._head] = self._coil_conductance(tick, duty)
-        opened = self._coil[:, :, (self._head - self.open_ticks) % depth]
-        still_on = self._coil[:, :, (self._head - self.close_ticks) % depth] > 0.0
-        return np.where(still_on, opened, 0.0)
+        coil = self._coil_conductance(tick, duty)
+        on = coil > 0.0
+        self._on_run = np.where(on, self._on_run + 1, 0)
+        self._off_run = np.where(on, 0, self._off_run + 1)
+        opens = ~self._open & (self._on_run > self.open_ticks)
+        shuts = self._open & (self._off_run > self.close_ticks)
+        self._open = (self._open | opens) & ~shuts
+        self._conductance = np.where(on, coil, self._conductance)
+        return np.where(self._open, self._conductance, 0.0)

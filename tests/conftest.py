@@ -1,0 +1,54 @@
+"""Shared helpers: open-loop runs on custom plants."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import pytest
+
+from controllers.open_loop import OpenLoop
+from twin.model import Orientation
+from twin.params import FrictionParams, JointParams, ValveParams
+from twin.plants import PLANTS, Plant
+from twin.scenario import Scenario
+from twin.simulation import Result, simulate
+from twin.valves import ValveModel
+
+R_SPUR = JointParams().gears.spur_radius  # m
+AREA = JointParams().cylinder.bore_area  # m^2
+
+
+def custom_plant(name: str, *, friction: FrictionParams | None = None, valves: ValveParams | None = None,
+                 valve_model: ValveModel = ValveModel.AVERAGED) -> Plant:
+    base = PLANTS["thesis"]
+    params = base.params
+    if friction is not None:
+        params = dataclasses.replace(params, friction=friction)
+    if valves is not None:
+        params = dataclasses.replace(params, valves=valves)
+    return Plant(name, params, valve_model, base.gain_set)
+
+
+def open_loop(duty, *, plant: str | Plant = "thesis", trajectory: int = 1, payload: float = 0.0,
+              orientation: Orientation = Orientation.HORIZONTAL, supply: float | None = None,
+              period: float = 16e-3) -> Result:
+    """Run with the duty schedule ``duty(t)`` (or a constant) and no sensor noise.
+
+    The trajectory only sets the start angle and duration: T1 starts at 20 deg
+    for 3 s, T3 at 80 deg for 4 s.
+    """
+    schedule = duty if callable(duty) else (lambda t: duty)
+    scenario = Scenario("ffpva", trajectory, payload=payload, orientation=orientation, plant=plant,
+                        noise=False, supply_pressure=supply)
+    return simulate([scenario], controllers=[OpenLoop(schedule=schedule, tick=1e-3, period=period)])[0]
+
+
+def deg(x: float) -> float:
+    return math.degrees(x)
+
+
+@pytest.fixture
+def frictionless() -> Plant:
+    return custom_plant("frictionless", friction=FrictionParams(
+        viscous=45.9, coulomb_poly=(0.0,), stiction=0.0))

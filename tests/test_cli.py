@@ -1,0 +1,125 @@
+"""``python -m twin`` end to end, in a subprocess and a scratch folder."""
+
+from __future__ import annotations
+
+import csv
+import json
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from twin.report import TRACE_COLUMNS
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+REQUIRED_KEYS = {"controller", "trajectory", "payload_g", "orientation", "plant", "seed", "rmse_deg",
+                 "sse_deg", "max_error_deg", "duration_s", "warnings"}
+PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
+
+
+def twin(cwd: pathlib.Path, *args: str) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(ROOT), PYTHONIOENCODING="utf-8", MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-m", "twin", *args], cwd=cwd, env=env, capture_output=True,
+                          text=True, encoding="utf-8", timeout=300)
+
+
+def run_json(cwd: pathlib.Path, *args: str) -> dict:
+    proc = twin(cwd, "run", "--controller", "ffpva", "--trajectory", "1", "--json", *args)
+    assert proc.returncode == 0, proc.stderr
+    lines = proc.stdout.splitlines()
+    assert len(lines) == 1, proc.stdout
+    record = json.loads(lines[0])
+    assert isinstance(record, dict)
+    return record
+
+
+def test_run_json_prints_one_record(tmp_path):
+    record = run_json(tmp_path, "--seed", "0")
+    assert REQUIRED_KEYS <= set(record)
+    assert record["controller"] == "ffpva"
+    assert record["trajectory"] == 1
+    assert record["payload_g"] == 0
+    assert record["orientation"] == "horizontal"
+    assert record["plant"] == "thesis"
+    assert record["seed"] == 0
+    assert record["duration_s"] == pytest.approx(3.0, abs=1e-9)  # T1: 1 s rise + 2 s hold (§7)
+    assert record["warnings"] == []
+    assert record["rmse_deg"] >= 0 and record["max_error_deg"] >= abs(record["sse_deg"])
+    assert list(tmp_path.iterdir()) == []  # --json alone writes nothing
+
+
+BASE = ["run", "--controller", "ffpva", "--trajectory", "1"]
+
+
+@pytest.mark.parametrize("args, bad", [
+    (["run", "--controller", "foo", "--trajectory", "1"], "foo"),
+    (["run", "--controller", "ffpva", "--trajectory", "7"], "7"),
+    (BASE + ["--payload", "abc"], "abc"),
+    (BASE + ["--payload", "-1"], "-1"),
+    (BASE + ["--supply-kpa", "800"], "800"),
+    (BASE + ["--plant", "nope"], "nope"),
+    (BASE + ["--orientation", "sideways"], "sideways"),
+    # the error names the folder that does not exist
+    (BASE + ["--trace", "no_such_folder/x.csv"], "no_such_folder"),
+    (BASE + ["--plot", "no_such_folder/x.png"], "no_such_folder"),
+    (BASE + ["--trace", "ok.csv", "--plot", "no_such_folder/x.png"], "no_such_folder"),
+])
+def test_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, args, bad):
+    proc = twin(tmp_path, *args)
+    assert proc.returncode == 2
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1, proc.stderr
+    assert lines[0].strip()
+    assert bad in lines[0]
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_trace_and_plot_files(tmp_path):
+    proc = twin(tmp_path, *BASE, "--seed", "0", "--trace", "out.csv", "--plot", "out.png")
+    assert proc.returncode == 0, proc.stderr
+    with open(tmp_path / "out.csv", newline="") as handle:
+        rows = list(csv.reader(handle))
+    header, data = rows[0], rows[1:]
+    assert tuple(header) == tuple(TRACE_COLUMNS)
+    assert len(data) == 3000  # T1 lasts 3 s, sampled every 1 ms
+    t = [float(r[header.index("t_s")]) for r in data]
+    assert t[0] == 0.0
+    assert t[1] == pytest.approx(1e-3, abs=1e-9)
+    assert t[-1] == pytest.approx(2.999, abs=1e-9)
+    theta_d = [float(r[header.index("theta_d_deg")]) for r in data]
+    assert theta_d[0] == pytest.approx(20.0, abs=1e-6)  # T1 starts at 20 deg
+    assert theta_d[-1] == pytest.approx(140.0, abs=1e-3)  # and holds at 20 + 120 deg
+    assert all(len(r) == len(header) for r in data)
+    assert (tmp_path / "out.png").read_bytes()[:8] == PNG_MAGIC
+
+
+def test_without_noise_two_runs_are_identical(tmp_path):
+    first = run_json(tmp_path, "--no-noise", "--seed", "0")
+    second = run_json(tmp_path, "--no-noise", "--seed", "0")
+    assert first == second
+
+
+def test_noise_seed_changes_the_result(tmp_path):
+    a = run_json(tmp_path, "--seed", "1")
+    b = run_json(tmp_path, "--seed", "2")
+    assert a["seed"] == 1 and b["seed"] == 2
+    assert a["rmse_deg"] != b["rmse_deg"]
+
+
+def test_demo_writes_results_and_summary(tmp_path):
+    proc = twin(tmp_path, "demo", "--seeds", "1", "--no-plots", "--out", "d")
+    assert proc.returncode == 0, proc.stderr
+    out = tmp_path / "d"
+    with open(out / "results.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    assert len(rows) == 12  # 3 controllers x 4 trajectories x 1 seed
+    pairs = {(r["controller"], int(r["trajectory"])) for r in rows}
+    assert pairs == {(c, t) for c in ("pva", "ffpva", "smc") for t in (1, 2, 3, 4)}
+    summary = (out / "summary.md").read_text(encoding="utf-8")
+    assert "| controller |" in summary
+    header = [line for line in proc.stdout.splitlines() if line.startswith("| controller |")]
+    assert len(header) == 1
+    assert "RMSE" in header[0]
+    assert not list(out.glob("*.png"))  # --no-plots

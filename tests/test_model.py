@@ -1,0 +1,87 @@
+"""The MJCF model: named, consistent with the typed parameters, composed by rebuilding."""
+
+from __future__ import annotations
+
+import math
+
+import mujoco
+import numpy as np
+import pytest
+
+from twin.exceptions import InvalidScenario
+from twin.model import MODEL_PATH, Orientation, compile_joint
+from twin.params import JointParams
+
+OBJECTS = [mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_GEOM, mujoco.mjtObj.mjOBJ_SITE,
+           mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SENSOR, mujoco.mjtObj.mjOBJ_EQUALITY,
+           mujoco.mjtObj.mjOBJ_TENDON]
+
+
+@pytest.mark.parametrize("payload", [0.0, 13.5e-3])
+def test_every_element_is_named(payload):
+    model = compile_joint(payload_mass=payload).model
+    counts = {mujoco.mjtObj.mjOBJ_BODY: model.nbody, mujoco.mjtObj.mjOBJ_JOINT: model.njnt,
+              mujoco.mjtObj.mjOBJ_GEOM: model.ngeom, mujoco.mjtObj.mjOBJ_SITE: model.nsite,
+              mujoco.mjtObj.mjOBJ_ACTUATOR: model.nu, mujoco.mjtObj.mjOBJ_SENSOR: model.nsensor,
+              mujoco.mjtObj.mjOBJ_EQUALITY: model.neq, mujoco.mjtObj.mjOBJ_TENDON: model.ntendon}
+    for kind in OBJECTS:
+        first = 1 if kind == mujoco.mjtObj.mjOBJ_BODY else 0  # the world body
+        for i in range(first, counts[kind]):
+            assert mujoco.mj_id2name(model, kind, i), f"unnamed {kind.name} {i}"
+
+
+def test_the_xml_on_disk_agrees_with_the_typed_parameters():
+    raw = mujoco.MjModel.from_xml_path(str(MODEL_PATH))
+    built = compile_joint().model  # adds the (empty) payload body
+    for name in ("rack_a", "rack_b", "pinion", "spur", "link"):
+        for field in ("mass", "inertia", "ipos"):
+            np.testing.assert_allclose(getattr(raw.body(name), field), getattr(built.body(name), field),
+                                       rtol=1e-5, atol=1e-15, err_msg=f"{name}.{field}")
+    for name in ("mesh_rack_b", "mesh_pinion", "mesh_spur"):
+        np.testing.assert_allclose(raw.equality(name).data, built.equality(name).data, rtol=1e-9, err_msg=name)
+    np.testing.assert_allclose(raw.site("link_tip").pos, built.site("link_tip").pos)
+
+
+def test_masses_come_from_spec_section_2():
+    p = JointParams()
+    assert p.cylinder.bore_area == pytest.approx(1.2566e-5, rel=1e-4)
+    assert p.masses.link_inertia == pytest.approx(2.45e-7, rel=1e-3)
+    assert p.gears.ratio == pytest.approx(2.57, abs=0.005)
+    joint = compile_joint()
+    assert joint.effective_mass == pytest.approx(
+        2 * p.masses.rack_side_mass + p.masses.pinion_inertia / p.gears.pinion_radius**2
+        + (p.masses.spur_inertia + p.masses.link_inertia) / p.gears.spur_radius**2, rel=1e-9)
+
+
+def test_payload_is_rebuilt_into_the_model_at_the_link_tip():
+    joint = compile_joint(payload_mass=13.5e-3)
+    model = joint.model
+    payload = model.body("payload")
+    assert payload.mass[0] == pytest.approx(13.5e-3)
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    tip = data.site("link_tip").xpos
+    np.testing.assert_allclose(data.body("payload").xpos, tip, atol=1e-12)
+    spur_axis = data.body("spur").xpos
+    assert np.linalg.norm((tip - spur_axis)[:2]) == pytest.approx(35e-3, rel=1e-9)
+
+
+def test_vertical_orientation_hangs_the_link_down_at_zero():
+    model = compile_joint(orientation=Orientation.VERTICAL).model
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    direction = data.site("link_tip").xpos - data.body("spur").xpos
+    assert direction[2] == pytest.approx(-35e-3, rel=1e-9)  # straight down (the 2 mm shaft offset is along world y)
+    assert direction[0] == pytest.approx(0.0, abs=1e-12)
+
+
+def test_solref_is_twice_the_timestep():
+    for timestep in (1e-3, 5e-4):
+        model = compile_joint(timestep=timestep).model
+        np.testing.assert_allclose(model.eq_solref[:, 0], 2 * timestep)
+
+
+@pytest.mark.parametrize("payload", [-1e-3, float("nan"), 1.0])
+def test_bad_payload_is_rejected(payload):
+    with pytest.raises(InvalidScenario):
+        compile_joint(payload_mass=payload)
