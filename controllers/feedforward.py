@@ -26,7 +26,7 @@ import dataclasses
 import numpy as np
 
 from twin import friction
-from twin.params import FrictionParams, JointParams, ValveParams
+from twin.params import NOMINAL_PARAMS, FrictionParams, JointParams, ValveParams
 
 
 @dataclasses.dataclass(frozen=True)
@@ -40,7 +40,7 @@ class NominalModel:
     friction: FrictionParams
 
     @classmethod
-    def thesis(cls, params: JointParams = JointParams()) -> "NominalModel":
+    def thesis(cls, params: JointParams = NOMINAL_PARAMS) -> NominalModel:
         return cls(supply_pressure=300e3, mass=params.masses.thesis_total_mass,
                    bore_area=params.cylinder.bore_area, valves=params.valves, friction=params.friction)
 

@@ -44,7 +44,7 @@ class FeedForwardPVA:
         check_period(self.period, self.tick)
 
     @classmethod
-    def thesis(cls, *, nominal: NominalModel, gain_set: str, tick: float) -> "FeedForwardPVA":
+    def thesis(cls, *, nominal: NominalModel, gain_set: str, tick: float) -> FeedForwardPVA:
         gains = FeedForwardPVAGains(pva=PVAGains(position=KP_BY_GAIN_SET[gain_set]))
         return cls(nominal=nominal, gains=gains, tick=tick)
 

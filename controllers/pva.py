@@ -57,7 +57,7 @@ class PVA:
         check_period(self.period, self.tick)
 
     @classmethod
-    def thesis(cls, *, nominal, gain_set: str, tick: float) -> "PVA":
+    def thesis(cls, *, nominal, gain_set: str, tick: float) -> PVA:
         del nominal, gain_set  # the baseline has one gain set and no model
         return cls(gains=PVAGains(), tick=tick)
 

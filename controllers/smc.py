@@ -54,7 +54,7 @@ class SlidingMode:
         self._held = np.zeros(0)
 
     @classmethod
-    def thesis(cls, *, nominal: NominalModel, gain_set: str, tick: float) -> "SlidingMode":
+    def thesis(cls, *, nominal: NominalModel, gain_set: str, tick: float) -> SlidingMode:
         gains = SlidingModeGains(pva=PVAGains(position=50_000.0), surface_slope=LAMBDA_BY_GAIN_SET[gain_set])
         return cls(nominal=nominal, gains=gains, tick=tick)
 

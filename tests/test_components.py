@@ -36,13 +36,8 @@ def test_observer_at_rest_estimates_zero_motion():
     assert np.all(v == 0.0) and np.all(a == 0.0)
 
 
-_OBSERVER_BIAS = ("SUSPECTED BUG in twin/sensing.py: the zero-order-hold discretisation "
-                  "v[k+1] = d v[k] + K (y[k+1] - y[k]) has slope gain K T / (1 - exp(-K T)) = 1.0508 "
-                  "at K = 100 /s, T = 1 ms: every velocity estimate is 5.1 % too large, unlike "
-                  "K s / (s + K) of eq. 5.2.2 (gain 1 on a ramp)")
 
 
-@pytest.mark.xfail(strict=True, reason=_OBSERVER_BIAS)
 def test_observer_velocity_of_a_ramp_converges_to_its_slope():
     """K s / (s + K) applied to y = s t: v_hat -> s with time constant 1/K = 10 ms."""
     slope = 0.01  # m/s
@@ -59,7 +54,6 @@ def test_observer_acceleration_of_a_ramp_converges_to_zero():
     assert np.max(np.abs(a[300:])) < 1e-6
 
 
-@pytest.mark.xfail(strict=True, reason=_OBSERVER_BIAS)
 @pytest.mark.parametrize("omega", [math.pi, 100.0])  # T3's 0.5 Hz, and the corner frequency
 def test_observer_sine_amplitude_follows_the_continuous_transfer(omega):
     amplitude, gain = 5e-3, 100.0

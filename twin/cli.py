@@ -2,6 +2,7 @@
 
     twin demo                      reproduce the thesis's controller comparison
     twin run --controller ffpva --trajectory 1 --json      one scenario
+    twin bench                     cost per simulated second
 
 Degrees, grams and kPa here; SI inside. Bad input gets a one-line error and
 exit code 2, and nothing is written.
@@ -116,6 +117,24 @@ def _cmd_demo(args: argparse.Namespace) -> int:
     return run_demo(out=args.out, seeds=args.seeds, plots=args.plots)
 
 
+def _cmd_bench(args: argparse.Namespace) -> int:
+    from twin.bench import measure
+
+    for line in measure(batch_size=args.batch).lines():
+        print(line)
+    return 0
+
+
+def _positive_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
+    return value
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="twin", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -123,9 +142,13 @@ def build_parser() -> argparse.ArgumentParser:
     demo = sub.add_parser("demo", help="reproduce the thesis's simulated controller comparison")
     demo.add_argument("--out", type=pathlib.Path, default=pathlib.Path("twin-demo"),
                       help="output folder (created; default ./twin-demo)")
-    demo.add_argument("--seeds", type=int, default=5, help="noise seeds per case (default 5)")
+    demo.add_argument("--seeds", type=_positive_int, default=5, help="noise seeds per case (default 5)")
     demo.add_argument("--plots", action=argparse.BooleanOptionalAction, default=True)
     demo.set_defaults(func=_cmd_demo)
+
+    bench = sub.add_parser("bench", help="cost per simulated second, as ratios to bare mj_step")
+    bench.add_argument("--batch", type=_positive_int, default=100, help="runs in the batched case (default 100)")
+    bench.set_defaults(func=_cmd_bench)
 
     run = sub.add_parser("run", help="simulate one scenario")
     add_scenario_arguments(run)

@@ -20,13 +20,14 @@ from __future__ import annotations
 import dataclasses
 import enum
 import math
+import os
 import pathlib
 
 import mujoco
 import numpy as np
 
 from twin.exceptions import InvalidScenario
-from twin.params import JointParams
+from twin.params import NOMINAL_PARAMS, JointParams
 
 MODEL_PATH = pathlib.Path(__file__).resolve().parent.parent / "models" / "joint.xml"
 
@@ -70,12 +71,15 @@ class JointModel:
 
 
 def _mjcf():
+    # dm_control picks a GL backend on import; without a display its default (GLFW)
+    # prints a warning. The twin never renders through dm_control, so default to EGL.
+    os.environ.setdefault("MUJOCO_GL", "egl")
     from dm_control import mjcf  # imported late: dm_control is slow to import
 
     return mjcf
 
 
-def build_mjcf(*, params: JointParams = JointParams(), payload_mass: float = 0.0,
+def build_mjcf(*, params: JointParams = NOMINAL_PARAMS, payload_mass: float = 0.0,
                orientation: Orientation = Orientation.HORIZONTAL, timestep: float = 1e-3):
     """The joint as a ``dm_control.mjcf`` element tree, ready to compile."""
     if not (0.0 <= payload_mass <= MAX_PAYLOAD) or not math.isfinite(payload_mass):
@@ -123,7 +127,7 @@ def build_mjcf(*, params: JointParams = JointParams(), payload_mass: float = 0.0
     return root
 
 
-def compile_joint(*, params: JointParams = JointParams(), payload_mass: float = 0.0,
+def compile_joint(*, params: JointParams = NOMINAL_PARAMS, payload_mass: float = 0.0,
                   orientation: Orientation = Orientation.HORIZONTAL, timestep: float = 1e-3) -> JointModel:
     """Compile the joint; see :func:`build_mjcf`. ``payload_mass`` in kg."""
     root = build_mjcf(params=params, payload_mass=payload_mass, orientation=orientation, timestep=timestep)

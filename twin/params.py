@@ -194,3 +194,6 @@ class JointParams:
     sensors: SensorParams = SensorParams()
     observer: ObserverParams = ObserverParams()
     gravity: float = 9.81  # m/s^2
+
+
+NOMINAL_PARAMS = JointParams()  # every SPEC value, unmodified

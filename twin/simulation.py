@@ -105,7 +105,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     h = plants[0].timestep
     if any(p.timestep != h for p in plants):
         raise InvalidScenario("scenarios in one batch must share the physics timestep")
-    joints = [_joint(p.params, s.payload, s.orientation, p.timestep) for s, p in zip(scenarios, plants)]
+    joints = [_joint(p.params, s.payload, s.orientation, p.timestep) for s, p in zip(scenarios, plants, strict=True)]
     dof = joints[0]
     if any((j.rack_a_dof, j.spur_dof) != (dof.rack_a_dof, dof.spur_dof) for j in joints):
         raise SimulationFailed("joint models disagree on their degrees of freedom")
@@ -117,23 +117,23 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     qfrc_bias, qfrc_passive = batch.bind("qfrc_bias"), batch.bind("qfrc_passive")
 
     spur_radius = np.array([p.params.gears.spur_radius for p in plants])
-    bore_area = np.array([p.params.cylinder.bore_area for p in plants])
+    np.array([p.params.cylinder.bore_area for p in plants])
     manifold = np.stack([j.manifold for j in joints])
     mass = np.array([j.effective_mass for j in joints])
     supply = np.array([s.supply for s in scenarios])
 
-    trajectories = [trajectory(s.trajectory, spur_radius=r) for s, r in zip(scenarios, spur_radius)]
+    trajectories = [trajectory(s.trajectory, spur_radius=r) for s, r in zip(scenarios, spur_radius, strict=True)]
     lengths = np.array([int(round(tr.duration / h)) for tr in trajectories])
     ticks = int(lengths.max())
     t = np.arange(ticks) * h
-    references = [tr.sample(t, r) for tr, r in zip(trajectories, spur_radius)]
+    references = [tr.sample(t, r) for tr, r in zip(trajectories, spur_radius, strict=True)]
     y_d = np.stack([ref.position for ref in references])
     v_d = np.stack([ref.velocity for ref in references])
     a_d = np.stack([ref.acceleration for ref in references])
 
     position_noise = np.zeros((n, ticks))
     pressure_noise = np.zeros((n, ticks, 3))
-    for i, (s, p) in enumerate(zip(scenarios, plants)):
+    for i, (s, p) in enumerate(zip(scenarios, plants, strict=True)):
         if s.noise:
             rng = np.random.default_rng(s.seed)
             position_noise[i, :lengths[i]] = uniform_noise(rng, p.params.sensors.position_noise, (lengths[i],))

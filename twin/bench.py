@@ -1,0 +1,60 @@
+"""``twin bench``: what a simulated second costs, as ratios measured in one run.
+
+Reports, for the joint model at the default timestep: a bare ``mj_step`` loop,
+one twin run (n = 1), and a batch of many runs (n = 100 by default), as wall
+seconds per simulated second, and the twin's cost per scenario-second relative
+to bare stepping. Timings on a shared machine are noisy: compare the ratios.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+
+import mujoco
+
+from twin.model import compile_joint
+from twin.runner import run_many
+from twin.scenario import Scenario
+
+
+@dataclasses.dataclass(frozen=True)
+class Bench:
+    bare_step: float  # wall s per simulated s, plain mj_step loop, one MjData
+    twin_single: float  # wall s per simulated s, one twin run
+    twin_batch: float  # wall s per simulated scenario-second, batch of `batch_size`
+    batch_size: int
+
+    def lines(self) -> list[str]:
+        return [
+            f"bare mj_step:          {self.bare_step * 1e3:8.2f} ms per simulated s",
+            f"twin, 1 run:           {self.twin_single * 1e3:8.2f} ms per simulated s "
+            f"({self.twin_single / self.bare_step:.1f}x bare)",
+            f"twin, {self.batch_size} runs batched: {self.twin_batch * 1e3:8.2f} ms per simulated scenario-s "
+            f"({self.twin_batch / self.bare_step:.2f}x bare; {self.twin_batch * self.batch_size * 1e3:.0f} ms "
+            f"per simulated s of the whole batch)",
+        ]
+
+
+def _bare_step_cost(seconds: float) -> float:
+    joint = compile_joint()
+    data = mujoco.MjData(joint.model)
+    steps = int(round(seconds / joint.timestep))
+    start = time.perf_counter()
+    mujoco.mj_step(joint.model, data, nstep=steps)
+    return (time.perf_counter() - start) / seconds
+
+
+def measure(*, batch_size: int = 100, trajectory: int = 1) -> Bench:
+    scenario = Scenario("ffpva", trajectory)
+    run_many([scenario])  # warm caches (model compile, imports)
+    start = time.perf_counter()
+    single = run_many([scenario])[0]
+    duration = float(len(single.trace.time)) * 1e-3
+    twin_single = (time.perf_counter() - start) / duration
+    batch = [Scenario("ffpva", trajectory, seed=s) for s in range(batch_size)]
+    start = time.perf_counter()
+    run_many(batch)
+    twin_batch = (time.perf_counter() - start) / (duration * batch_size)
+    return Bench(bare_step=_bare_step_cost(duration * 10), twin_single=twin_single,
+                 twin_batch=twin_batch, batch_size=batch_size)
