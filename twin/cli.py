@@ -38,34 +38,24 @@ def _writable_file(text: str) -> pathlib.Path:
     return path
 
 
-def _grams(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"payload must be a number of grams, got {text!r}") from None
-    if not math.isfinite(value) or value < 0:
-        raise argparse.ArgumentTypeError(f"payload must be a non-negative number of grams, got {text!r}")
-    return value
+def _checked(kind: type, accept, requirement: str):
+    """An argparse type: parse with ``kind``, keep it if ``accept(value)``, else name the bad text."""
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            value = None
+        if value is None or not math.isfinite(value) or not accept(value):
+            raise argparse.ArgumentTypeError(f"{requirement}, got {text!r}")
+        return value
+
+    return parse
 
 
-def _kpa(text: str) -> float:
-    try:
-        value = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"supply pressure must be a number of kPa, got {text!r}") from None
-    if not math.isfinite(value) or not 0 < value <= 700:
-        raise argparse.ArgumentTypeError(f"supply pressure must be in (0, 700] kPa (cylinder rating), got {text!r}")
-    return value
-
-
-def _seed(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"seed must be a non-negative integer, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"seed must be a non-negative integer, got {text!r}")
-    return value
+_grams = _checked(float, lambda v: v >= 0, "payload must be a non-negative number of grams")
+_kpa = _checked(float, lambda v: 0 < v <= 700, "supply pressure must be in (0, 700] kPa (cylinder rating)")
+_seed = _checked(int, lambda v: v >= 0, "seed must be a non-negative integer")
+_positive_int = _checked(int, lambda v: v >= 1, "expected a positive integer")
 
 
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
@@ -123,16 +113,6 @@ def _cmd_bench(args: argparse.Namespace) -> int:
     for line in measure(batch_size=args.batch).lines():
         print(line)
     return 0
-
-
-def _positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"expected a positive integer, got {text!r}")
-    return value
 
 
 def build_parser() -> argparse.ArgumentParser:
