@@ -26,7 +26,7 @@ AREA = math.pi * 0.002**2  # m^2
 # --------------------------------------------------------------------------- observer (eq. 5.2.2)
 
 def _observe(signal: np.ndarray, gain: float = 100.0) -> tuple[np.ndarray, np.ndarray]:
-    obs = FirstOrderObserver(params=ObserverParams(gain=gain), sample_period=DT, initial=np.array([signal[0]]))
+    obs = FirstOrderObserver(gain=ObserverParams(gain=gain).gain, sample_period=DT, initial=np.array([signal[0]]))
     out = [obs.update(np.array([y])) for y in signal]
     return np.array([v[0] for v, _ in out]), np.array([a[0] for _, a in out])
 

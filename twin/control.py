@@ -21,6 +21,11 @@ class Measurement:
     acceleration: np.ndarray  # m/s^2, observer estimate
     supply_pressure: np.ndarray  # Pa, measured
 
+    def subset(self, idx: np.ndarray) -> Measurement:
+        """The measurements of the scenarios ``idx``."""
+        return Measurement(position=self.position[idx], velocity=self.velocity[idx],
+                           acceleration=self.acceleration[idx], supply_pressure=self.supply_pressure[idx])
+
 
 @dataclasses.dataclass(frozen=True)
 class Setpoint:

@@ -9,11 +9,7 @@ change any scenario's numbers.
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
-
-from twin.params import ObserverParams
 
 
 def uniform_noise(rng: np.random.Generator, bound: float, shape: tuple[int, ...]) -> np.ndarray:
@@ -33,9 +29,9 @@ class FirstOrderObserver:
     Arrays are (n,).
     """
 
-    def __init__(self, *, params: ObserverParams, sample_period: float, initial: np.ndarray):
-        self.gain = params.gain
-        self._decay = math.exp(-params.gain * sample_period)
+    def __init__(self, *, gain: np.ndarray | float, sample_period: float, initial: np.ndarray):
+        self.gain = gain  # 1/s, K_OB, per scenario
+        self._decay = np.exp(-np.asarray(gain, dtype=float) * sample_period)
         self._period = sample_period
         self._position = np.array(initial, dtype=float)
         self._velocity = np.zeros_like(self._position)

@@ -25,18 +25,16 @@ import mujoco
 import mujoco.batch
 import numpy as np
 
-from twin import hydraulics
-from twin.control import Controller, Measurement, Setpoint
+from twin.control import Controller, Setpoint
 from twin.exceptions import InvalidScenario, SimulationFailed
 from twin.metrics import Metrics, tracking_metrics
 from twin.model import JointModel, Orientation, compile_joint
 from twin.params import JointParams
+from twin.plant_state import PlantState, groups, place_on_manifold
 from twin.plants import Plant
 from twin.scenario import Scenario
-from twin.sensing import FirstOrderObserver, uniform_noise
 from twin.ticks import whole_ticks
 from twin.trajectories import trajectory
-from twin.valves import ValveBank
 
 PROGRESS_EVERY = 250  # ticks between progress callbacks
 
@@ -70,13 +68,6 @@ class Result:
 @functools.lru_cache(maxsize=64)
 def _joint(params: JointParams, payload: float, orientation: Orientation, timestep: float) -> JointModel:
     return compile_joint(params=params, payload_mass=payload, orientation=orientation, timestep=timestep)
-
-
-def _groups(keys: Sequence) -> dict:
-    groups: dict = {}
-    for i, key in enumerate(keys):
-        groups.setdefault(key, []).append(i)
-    return {key: np.array(idx) for key, idx in groups.items()}
 
 
 def _warnings(data: mujoco.MjData) -> tuple[str, ...]:
@@ -117,13 +108,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     qfrc_bias, qfrc_passive = batch.bind("qfrc_bias"), batch.bind("qfrc_passive")
 
     spur_radius = np.array([p.params.gears.spur_radius for p in plants])
-    np.array([p.params.cylinder.bore_area for p in plants])
-    manifold = np.stack([j.manifold for j in joints])
-    mass = np.array([j.effective_mass for j in joints])
-    supply = np.array([s.supply for s in scenarios])
-
     trajectories = [trajectory(s.trajectory, spur_radius=r) for s, r in zip(scenarios, spur_radius, strict=True)]
-    lengths = np.array([int(round(tr.duration / h)) for tr in trajectories])
+    lengths = np.array([whole_ticks(tr.duration, h, what="trajectory") for tr in trajectories])
     ticks = int(lengths.max())
     t = np.arange(ticks) * h
     references = [tr.sample(t, r) for tr, r in zip(trajectories, spur_radius, strict=True)]
@@ -131,76 +117,40 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     v_d = np.stack([ref.velocity for ref in references])
     a_d = np.stack([ref.acceleration for ref in references])
 
-    position_noise = np.zeros((n, ticks))
-    pressure_noise = np.zeros((n, ticks, 3))
-    for i, (s, p) in enumerate(zip(scenarios, plants, strict=True)):
-        if s.noise:
-            rng = np.random.default_rng(s.seed)
-            position_noise[i, :lengths[i]] = uniform_noise(rng, p.params.sensors.position_noise, (lengths[i],))
-            pressure_noise[i, :lengths[i]] = uniform_noise(rng, p.params.sensors.pressure_noise, (lengths[i], 3))
-
-    y0 = y_d[:, 0]
-    qpos[:, dof.rack_a_dof] = y0
-    qpos[:, dof.rack_b_dof] = -y0
-    qpos[:, dof.pinion_dof] = -y0 / np.array([p.params.gears.pinion_radius for p in plants])
-    qpos[:, dof.spur_dof] = y0 / spur_radius
+    for i, joint in enumerate(joints):
+        place_on_manifold(qpos[i:i + 1], joint, y_d[i:i + 1, 0])
     qvel[:] = 0.0
     batch.forward()
+    plant = PlantState(scenarios=scenarios, joints=joints, lengths=lengths, initial_position=y_d[:, 0], tick=h)
 
     if len(controllers) != n:
         raise InvalidScenario(f"{len(controllers)} controllers for {n} scenarios")
     controller_groups = []
-    for _, idx in _groups([id(c) for c in controllers]).items():
+    for _, idx in groups([id(c) for c in controllers]).items():
         controller = controllers[idx[0]]
         controller.reset(len(idx))
         controller_groups.append((controller, idx, whole_ticks(controller.period, h, what="controller period")))
-    plant_groups = []
-    for preset, idx in _groups(plants).items():
-        bank = ValveBank(params=preset.params.valves, model=preset.valve_model, n=len(idx), tick=h)
-        plant_groups.append((preset, idx, bank))
 
-    observer = FirstOrderObserver(params=plants[0].params.observer, sample_period=h, initial=y0 + position_noise[:, 0])
     duty = np.zeros(n)
-    conductance = np.zeros((n, 4))
-    stuck = np.ones(n, dtype=bool)
-    pressure_a = np.zeros(n)
-    pressure_b = np.zeros(n)
-    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps")}
+    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb")}
     valve_open = np.zeros((n, ticks, 4), dtype=bool)
-
     for k in range(ticks):
         y = qpos[:, dof.rack_a_dof].copy()
         v = qvel[:, dof.rack_a_dof].copy()
-        y_measured = y + position_noise[:, k]
-        v_hat, a_hat = observer.update(y_measured)
-        supply_measured = supply + pressure_noise[:, k, 2]
+        measurement = plant.sense(k, y)
         for controller, idx, every in controller_groups:
             if k % every == 0:
-                measurement = Measurement(position=y_measured[idx], velocity=v_hat[idx],
-                                          acceleration=a_hat[idx], supply_pressure=supply_measured[idx])
                 setpoint = Setpoint(position=y_d[idx, k], velocity=v_d[idx, k], acceleration=a_d[idx, k])
-                duty[idx] = controller.update(k * h, measurement, setpoint)
-        external = np.einsum("ij,ij->i", qfrc_passive - qfrc_bias, manifold)
-        for preset, idx, bank in plant_groups:
-            conductance[idx] = bank.update(k, duty[idx])
-            circuit = hydraulics.circuit(conductance[idx], supply[idx], preset.params.cylinder.bore_area)
-            forces = hydraulics.rack_step(
-                circuit_now=circuit, friction_params=preset.params.friction,
-                bore_area=preset.params.cylinder.bore_area, y=y[idx], v0=v[idx],
-                external_force=external[idx], stuck=stuck[idx], mass=mass[idx], h=h)
-            ctrl[idx, 0] = forces.cylinder_a
-            ctrl[idx, 1] = forces.cylinder_b
-            stuck[idx] = forces.stuck
-            pressure_a[idx], pressure_b[idx] = forces.pressure_a, forces.pressure_b
+                duty[idx] = controller.update(k * h, measurement.subset(idx), setpoint)
+        ctrl[:, 0], ctrl[:, 1] = plant.actuate(k, duty, y, v, plant.external_force(qfrc_passive, qfrc_bias))
         rec["y"][:, k] = y
-        rec["ym"][:, k] = y_measured
+        rec["ym"][:, k] = measurement.position
         rec["theta"][:, k] = qpos[:, dof.spur_dof]
         rec["duty"][:, k] = duty
-        rec["pa"][:, k] = pressure_a
-        rec["pb"][:, k] = pressure_b
-        rec["ps"][:, k] = supply
-        valve_open[:, k] = conductance > 0
-        batch.step()
+        rec["pa"][:, k] = plant.pressure_a
+        rec["pb"][:, k] = plant.pressure_b
+        valve_open[:, k] = plant.conductance > 0
+        batch.step(stage=int(mujoco.mjtStage.mjSTAGE_VEL))  # derived fields (gravity) at the new state
         if progress is not None and (k % PROGRESS_EVERY == 0 or k == ticks - 1):
             progress(k + 1, ticks)
 
@@ -216,7 +166,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         trace = Trace(
             time=t[:T], desired_angle=desired, angle=theta, rack_position=rec["y"][i, :T],
             measured_position=rec["ym"][i, :T], duty=rec["duty"][i, :T], valve_open=valve_open[i, :T],
-            pressure_a=rec["pa"][i, :T], pressure_b=rec["pb"][i, :T], supply_pressure=rec["ps"][i, :T],
+            pressure_a=rec["pa"][i, :T], pressure_b=rec["pb"][i, :T], supply_pressure=np.full(T, plant.supply[i]),
             coupling_error=theta - rec["y"][i, :T] / spur_radius[i],
         )
         results.append(Result(scenario=s, trace=trace, metrics=tracking_metrics(desired, theta),

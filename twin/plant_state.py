@@ -1,0 +1,111 @@
+"""The plant side of n scenarios between MuJoCo steps: one implementation for
+every loop that drives the joint (``twin.simulation`` and ``twin.env``).
+
+Per tick k, given the true rack state from MuJoCo:
+
+``sense(k, y)``
+    the Hall sample with its seeded noise, the observer's v_hat and a_hat,
+    and the measured supply pressure -> a :class:`Measurement`;
+``actuate(k, duty, y, v, external)``
+    the valves (delays, dead zone, PWM), the hydraulic circuit and the implicit
+    rack step with friction -> the two piston forces to write into ``ctrl``.
+
+Arrays have a leading scenario axis (n,). Scenarios keep their own noise
+generator (seeded by ``Scenario.seed``), so batching does not change any
+scenario's numbers.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+
+from twin import hydraulics
+from twin.control import Measurement
+from twin.model import JointModel
+from twin.plants import Plant
+from twin.scenario import Scenario
+from twin.sensing import FirstOrderObserver, uniform_noise
+from twin.valves import ValveBank
+
+
+def groups(keys: Sequence) -> dict:
+    """Indices of equal keys, in first-seen order: {key: array of indices}."""
+    found: dict = {}
+    for i, key in enumerate(keys):
+        found.setdefault(key, []).append(i)
+    return {key: np.array(idx) for key, idx in found.items()}
+
+
+def place_on_manifold(qpos: np.ndarray, joint: JointModel, y: np.ndarray) -> None:
+    """Write rack position(s) ``y`` (m) into ``qpos`` rows (n, nq) with the gears coupled."""
+    dofs = [joint.rack_a_dof, joint.rack_b_dof, joint.pinion_dof, joint.spur_dof]
+    qpos[:, dofs] = np.asarray(y)[:, None] * joint.manifold[dofs][None, :]
+
+
+class PlantState:
+    """Noise, sensors, observer, valves and hydraulics for ``scenarios``.
+
+    ``lengths[i]`` is scenario i's number of ticks (its noise is drawn for
+    exactly that many, so a scenario's noise does not depend on its batch);
+    ``initial_position`` (n,) is where each rack starts at rest (m).
+    """
+
+    def __init__(self, *, scenarios: Sequence[Scenario], joints: Sequence[JointModel], lengths: Sequence[int],
+                 initial_position: np.ndarray, tick: float):
+        n = len(scenarios)
+        self.n, self.tick = n, tick
+        self.plants: list[Plant] = [s.preset for s in scenarios]
+        self.supply = np.array([s.supply for s in scenarios])  # Pa
+        self.mass = np.array([j.effective_mass for j in joints])  # kg
+        self.manifold = np.stack([j.manifold for j in joints])  # (n, nv)
+        ticks = int(max(lengths))
+        self.position_noise = np.zeros((n, ticks))
+        self.pressure_noise = np.zeros((n, ticks, 3))  # chamber A, chamber B, supply
+        for i, (s, p, length) in enumerate(zip(scenarios, self.plants, lengths, strict=True)):
+            if s.noise:
+                rng = np.random.default_rng(s.seed)
+                self.position_noise[i, :length] = uniform_noise(rng, p.params.sensors.position_noise, (length,))
+                self.pressure_noise[i, :length] = uniform_noise(rng, p.params.sensors.pressure_noise, (length, 3))
+        self.observer = FirstOrderObserver(
+            gain=np.array([p.params.observer.gain for p in self.plants]), sample_period=tick,
+            initial=np.asarray(initial_position, dtype=float) + self.position_noise[:, 0])
+        self._plant_groups = [
+            (preset, idx, ValveBank(params=preset.params.valves, model=preset.valve_model, n=len(idx), tick=tick))
+            for preset, idx in groups(self.plants).items()]
+        self.conductance = np.zeros((n, 4))  # m^3/(Pa s), V1..V4
+        self.stuck = np.ones(n, dtype=bool)
+        self.pressure_a = np.zeros(n)  # Pa
+        self.pressure_b = np.zeros(n)  # Pa
+
+    def sense(self, k: int, y: np.ndarray) -> Measurement:
+        """Sample the sensors at tick k from the true rack position ``y`` (n,)."""
+        measured = y + self.position_noise[:, k]
+        velocity, acceleration = self.observer.update(measured)
+        return Measurement(position=measured, velocity=velocity, acceleration=acceleration,
+                           supply_pressure=self.supply + self.pressure_noise[:, k, 2])
+
+    def measured_pressures(self, k: int) -> tuple[np.ndarray, np.ndarray]:
+        """Chamber pressures A and B as the pressure sensors read them (Pa)."""
+        return self.pressure_a + self.pressure_noise[:, k, 0], self.pressure_b + self.pressure_noise[:, k, 1]
+
+    def external_force(self, qfrc_passive: np.ndarray, qfrc_bias: np.ndarray) -> np.ndarray:
+        """Everything MuJoCo applies along +y besides the pistons (gravity), (n,) in N."""
+        return np.einsum("ij,ij->i", qfrc_passive - qfrc_bias, self.manifold)
+
+    def actuate(self, k: int, duty: np.ndarray, y: np.ndarray, v: np.ndarray,
+                external: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Piston forces (cylinder A, cylinder B) in N for the duty command (n,) in %."""
+        force_a, force_b = np.zeros(self.n), np.zeros(self.n)
+        for preset, idx, bank in self._plant_groups:
+            self.conductance[idx] = bank.update(k, duty[idx])
+            area = preset.params.cylinder.bore_area
+            forces = hydraulics.rack_step(
+                circuit_now=hydraulics.circuit(self.conductance[idx], self.supply[idx], area),
+                friction_params=preset.params.friction, bore_area=area, y=y[idx], v0=v[idx],
+                external_force=external[idx], stuck=self.stuck[idx], mass=self.mass[idx], h=self.tick)
+            force_a[idx], force_b[idx] = forces.cylinder_a, forces.cylinder_b
+            self.stuck[idx] = forces.stuck
+            self.pressure_a[idx], self.pressure_b[idx] = forces.pressure_a, forces.pressure_b
+        return force_a, force_b
