@@ -1,9 +1,9 @@
 """``twin bench``: what a simulated second costs, as ratios measured in one run.
 
 Reports, for the joint model at the default timestep: a bare ``mj_step`` loop,
-one twin run (n = 1), and a batch of many runs (n = 100 by default), as wall
-seconds per simulated second, and the twin's cost per scenario-second relative
-to bare stepping. Timings on a shared machine are noisy: compare the ratios.
+one twin run (n = 1), a batch of many runs (n = 100 by default), and the same
+single run through the dm_control environment, as wall seconds per simulated
+second, with their ratios. Timings on a shared machine are noisy: compare the ratios.
 """
 
 from __future__ import annotations
@@ -24,6 +24,7 @@ class Bench:
     twin_single: float  # wall s per simulated s, one twin run
     twin_batch: float  # wall s per simulated scenario-second, batch of `batch_size`
     batch_size: int
+    env_single: float  # wall s per simulated s, the dm_control environment, same scenario and policy
 
     def lines(self) -> list[str]:
         return [
@@ -33,6 +34,8 @@ class Bench:
             f"twin, {self.batch_size} runs batched: {self.twin_batch * 1e3:8.2f} ms per simulated scenario-s "
             f"({self.twin_batch / self.bare_step:.2f}x bare; {self.twin_batch * self.batch_size * 1e3:.0f} ms "
             f"per simulated s of the whole batch)",
+            f"dm_control env, 1 run: {self.env_single * 1e3:8.2f} ms per simulated s "
+            f"({self.env_single / self.twin_single:.2f}x the twin's own loop)",
         ]
 
 
@@ -57,4 +60,21 @@ def measure(*, batch_size: int = 100, trajectory: int = 1) -> Bench:
     run_many(batch)
     twin_batch = (time.perf_counter() - start) / (duration * batch_size)
     return Bench(bare_step=_bare_step_cost(duration * 10), twin_single=twin_single,
-                 twin_batch=twin_batch, batch_size=batch_size)
+                 twin_batch=twin_batch, batch_size=batch_size, env_single=_env_cost(trajectory, duration))
+
+
+def _env_cost(trajectory: int, duration: float) -> float:
+    """One FF + PVA episode through twin.env, the same scenario as the single twin run."""
+    from controllers import make_controller
+    from controllers.feedforward import NominalModel
+    from controllers.policy import ControllerPolicy
+    from twin import env as joint_env
+
+    controller = make_controller("ffpva", nominal=NominalModel.thesis(), gain_set="simulation", tick=1e-3)
+    environment = joint_env.load("track", trajectory=trajectory, seed=0)
+    start = time.perf_counter()
+    timestep = environment.reset()
+    policy = ControllerPolicy(controller, spur_radius=environment.physics.spur_radius)
+    while not timestep.last():
+        timestep = environment.step(policy(timestep))
+    return (time.perf_counter() - start) / duration
