@@ -17,7 +17,9 @@ GAIN_SETS = ("simulation", "experiment")
 
 
 def make_controller(name: str, *, nominal: NominalModel, gain_set: str, tick: float):
-    """A controller by name with the thesis's simulation or experiment gains."""
+    """A controller by name with the thesis's simulation or experiment gains.
+
+    Its PWM-rate part runs once per ``nominal.valves.pwm_period``."""
     if name not in CONTROLLERS:
         raise InvalidScenario(f"unknown controller {name!r}: choose one of {', '.join(CONTROLLERS)}")
     if gain_set not in GAIN_SETS:

@@ -46,7 +46,7 @@ class FeedForwardPVA:
     @classmethod
     def thesis(cls, *, nominal: NominalModel, gain_set: str, tick: float) -> FeedForwardPVA:
         gains = FeedForwardPVAGains(pva=PVAGains(position=KP_BY_GAIN_SET[gain_set]))
-        return cls(nominal=nominal, gains=gains, tick=tick)
+        return cls(nominal=nominal, gains=gains, tick=tick, period=nominal.valves.pwm_period)
 
     def reset(self, n: int) -> None:
         del n

@@ -58,8 +58,8 @@ class PVA:
 
     @classmethod
     def thesis(cls, *, nominal, gain_set: str, tick: float) -> PVA:
-        del nominal, gain_set  # the baseline has one gain set and no model
-        return cls(gains=PVAGains(), tick=tick)
+        del gain_set  # the baseline has one gain set and no model
+        return cls(gains=PVAGains(), tick=tick, period=nominal.valves.pwm_period)
 
     def reset(self, n: int) -> None:
         del n

@@ -56,7 +56,7 @@ class SlidingMode:
     @classmethod
     def thesis(cls, *, nominal: NominalModel, gain_set: str, tick: float) -> SlidingMode:
         gains = SlidingModeGains(pva=PVAGains(position=50_000.0), surface_slope=LAMBDA_BY_GAIN_SET[gain_set])
-        return cls(nominal=nominal, gains=gains, tick=tick)
+        return cls(nominal=nominal, gains=gains, tick=tick, slow_period=nominal.valves.pwm_period)
 
     def reset(self, n: int) -> None:
         self._calls = 0

@@ -23,6 +23,7 @@ class Scenario:
     seed: int = 0
     noise: bool = True  # the thesis's sensor noise (§5)
     supply_pressure: float | None = None  # Pa gauge; None: the plant's
+    pwm_period: float | None = None  # s; None: the plant's (16 ms); a whole number of ticks
 
     def __post_init__(self) -> None:
         if self.controller not in CONTROLLER_NAMES:
@@ -33,6 +34,13 @@ class Scenario:
             raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, got {self.payload!r} kg")
         if not isinstance(self.orientation, Orientation):
             raise InvalidScenario(f"orientation must be an Orientation, got {self.orientation!r}")
+        if self.pwm_period is not None:
+            base = self.plant if isinstance(self.plant, Plant) else plant(self.plant)
+            ticks = self.pwm_period / base.timestep
+            if not math.isfinite(self.pwm_period) or self.pwm_period <= 0 or abs(ticks - round(ticks)) > 1e-9 \
+                    or not 4 <= round(ticks) <= 100:
+                raise InvalidScenario(f"PWM period must be a whole number of {base.timestep * 1e3:g} ms ticks "
+                                      f"between 4 and 100 ticks, got {self.pwm_period * 1e3:g} ms")
         preset = self.preset
         if not isinstance(self.seed, int) or self.seed < 0:
             raise InvalidScenario(f"seed must be a non-negative integer, got {self.seed!r}")
@@ -45,7 +53,12 @@ class Scenario:
 
     @property
     def preset(self) -> Plant:
-        return self.plant if isinstance(self.plant, Plant) else plant(self.plant)
+        """The plant this scenario runs, with its PWM period applied."""
+        base = self.plant if isinstance(self.plant, Plant) else plant(self.plant)
+        if self.pwm_period is None or self.pwm_period == base.params.valves.pwm_period:
+            return base
+        valves = dataclasses.replace(base.params.valves, pwm_period=self.pwm_period)
+        return dataclasses.replace(base, params=dataclasses.replace(base.params, valves=valves))
 
     @property
     def plant_name(self) -> str:

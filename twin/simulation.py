@@ -54,6 +54,9 @@ class Trace:
     pressure_b: np.ndarray  # Pa
     supply_pressure: np.ndarray  # Pa
     coupling_error: np.ndarray  # rad, spur angle - y / r_s
+    tooth_force_spur: np.ndarray  # N, pinion-spur mesh: spur coupling torque / r_s
+    tooth_force_rack_a: np.ndarray  # N, rack A - pinion mesh: what rack A pushes into the teeth
+    tooth_force_rack_b: np.ndarray  # N, rack B - pinion mesh
 
 
 @dataclasses.dataclass(frozen=True)
@@ -106,6 +109,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         batch.set_models([j.model for j in joints])
     qpos, qvel, ctrl = batch.bind("qpos"), batch.bind("qvel"), batch.bind("ctrl")
     qfrc_bias, qfrc_passive = batch.bind("qfrc_bias"), batch.bind("qfrc_passive")
+    qfrc_constraint = batch.bind("qfrc_constraint")
 
     spur_radius = np.array([p.params.gears.spur_radius for p in plants])
     trajectories = [trajectory(s.trajectory, spur_radius=r) for s, r in zip(scenarios, spur_radius, strict=True)]
@@ -132,7 +136,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         controller_groups.append((controller, idx, whole_ticks(controller.period, h, what="controller period")))
 
     duty = np.zeros(n)
-    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb")}
+    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "fs", "fa", "fb")}
     valve_open = np.zeros((n, ticks, 4), dtype=bool)
     for k in range(ticks):
         y = qpos[:, dof.rack_a_dof].copy()
@@ -151,6 +155,10 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         rec["pb"][:, k] = plant.pressure_b
         valve_open[:, k] = plant.conductance > 0
         batch.step(stage=int(mujoco.mjtStage.mjSTAGE_VEL))  # derived fields (gravity) at the new state
+        # Constraint forces of this step (computed at tick k's state; not refreshed by the stage above).
+        rec["fs"][:, k] = np.abs(qfrc_constraint[:, dof.spur_dof]) / spur_radius
+        rec["fa"][:, k] = np.abs(qfrc_constraint[:, dof.rack_a_dof])
+        rec["fb"][:, k] = np.abs(qfrc_constraint[:, dof.rack_b_dof])
         if progress is not None and (k % PROGRESS_EVERY == 0 or k == ticks - 1):
             progress(k + 1, ticks)
 
@@ -168,6 +176,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
             measured_position=rec["ym"][i, :T], duty=rec["duty"][i, :T], valve_open=valve_open[i, :T],
             pressure_a=rec["pa"][i, :T], pressure_b=rec["pb"][i, :T], supply_pressure=np.full(T, plant.supply[i]),
             coupling_error=theta - rec["y"][i, :T] / spur_radius[i],
+            tooth_force_spur=rec["fs"][i, :T], tooth_force_rack_a=rec["fa"][i, :T],
+            tooth_force_rack_b=rec["fb"][i, :T],
         )
         results.append(Result(scenario=s, trace=trace, metrics=tracking_metrics(desired, theta),
                               warnings=warnings, wall_time=wall))
