@@ -35,7 +35,7 @@ def open_loop(duty, *, plant: str | Plant = "thesis", trajectory: int = 1, paylo
               period: float = 16e-3) -> Result:
     """Run with the duty schedule ``duty(t)`` (or a constant) and no sensor noise.
 
-    The trajectory only sets the start angle and duration: T1 starts at 20 deg
+    The trajectory only sets the start angle and duration: T1 starts at 30 deg
     for 3 s, T3 at 80 deg for 4 s.
     """
     schedule = duty if callable(duty) else (lambda t: duty)

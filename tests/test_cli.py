@@ -89,8 +89,8 @@ def test_trace_and_plot_files(tmp_path):
     assert t[1] == pytest.approx(1e-3, abs=1e-9)
     assert t[-1] == pytest.approx(2.999, abs=1e-9)
     theta_d = [float(r[header.index("theta_d_deg")]) for r in data]
-    assert theta_d[0] == pytest.approx(20.0, abs=1e-6)  # T1 starts at 20 deg
-    assert theta_d[-1] == pytest.approx(140.0, abs=1e-3)  # and holds at 20 + 120 deg
+    assert theta_d[0] == pytest.approx(30.0, abs=1e-6)  # T1 starts at 30 deg
+    assert theta_d[-1] == pytest.approx(150.0, abs=1e-3)  # and holds at 30 + 120 deg
     assert all(len(r) == len(header) for r in data)
     assert (tmp_path / "out.png").read_bytes()[:8] == PNG_MAGIC
 
@@ -120,6 +120,6 @@ def test_demo_writes_results_and_summary(tmp_path):
     summary = (out / "summary.md").read_text(encoding="utf-8")
     assert "| controller |" in summary
     header = [line for line in proc.stdout.splitlines() if line.startswith("| controller |")]
-    assert len(header) == 1
-    assert "RMSE" in header[0]
+    assert len(header) == 2  # the comparison table and T4's rest errors
+    assert "RMSE" in header[0] and "T4 rest errors" in header[1]
     assert not list(out.glob("*.png"))  # --no-plots

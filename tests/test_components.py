@@ -103,8 +103,8 @@ def test_trajectory_durations(n, duration):
 def test_t1_rises_120_degrees_to_140_and_holds():
     t = np.arange(3000) * DT
     theta = _deg_at(1, t)
-    assert theta[0] == pytest.approx(20.0, abs=1e-9)
-    assert theta[t >= 1.0] == pytest.approx(140.0, abs=1e-9)
+    assert theta[0] == pytest.approx(30.0, abs=1e-9)  # inside the friction fit (SPEC §7)
+    assert theta[t >= 1.0] == pytest.approx(150.0, abs=1e-9)
 
 
 def test_t1_peak_acceleration_is_the_cycloid_amplitude():
@@ -124,7 +124,7 @@ def test_t2_ramps_at_10_mm_per_second():
     during = (t > 0.01) & (t < ramp_time - 0.01)
     assert ref.velocity[during] == pytest.approx(10e-3, rel=1e-9)
     assert np.diff(ref.position[during]) / DT == pytest.approx(10e-3, rel=1e-6)
-    assert np.degrees(ref.position[t > ramp_time + 0.01] / R_SPUR) == pytest.approx(140.0, abs=1e-9)
+    assert np.degrees(ref.position[t > ramp_time + 0.01] / R_SPUR) == pytest.approx(150.0, abs=1e-9)
 
 
 def test_t3_is_a_half_hertz_sine_between_20_and_140_degrees():
@@ -135,12 +135,12 @@ def test_t3_is_a_half_hertz_sine_between_20_and_140_degrees():
     assert _deg_at(3, [0.5, 1.5, 2.5]) == pytest.approx([140.0, 20.0, 140.0], abs=1e-9)  # period 2 s
 
 
-def test_t4_visits_140_20_80_20_degrees():
+def test_t4_visits_150_30_90_30_degrees():
     # moves end at 1, 3, 4 and 5 s (1 + rest 1 + 1 + rest 0.5 + 0.5 + rest 0.5 + 0.5); check at the end
     # of each move and in the rest that follows
-    assert _deg_at(4, [1.0, 3.0, 4.0, 5.0]) == pytest.approx([140.0, 20.0, 80.0, 20.0], abs=1e-9)
-    assert _deg_at(4, [1.5, 3.25, 4.25, 5.5, 5.999]) == pytest.approx([140.0, 20.0, 80.0, 20.0, 20.0], abs=1e-9)
-    assert _deg_at(4, [0.0])[0] == pytest.approx(20.0, abs=1e-9)
+    assert _deg_at(4, [1.0, 3.0, 4.0, 5.0]) == pytest.approx([150.0, 30.0, 90.0, 30.0], abs=1e-9)
+    assert _deg_at(4, [1.5, 3.25, 4.25, 5.5, 5.999]) == pytest.approx([150.0, 30.0, 90.0, 30.0, 30.0], abs=1e-9)
+    assert _deg_at(4, [0.0])[0] == pytest.approx(30.0, abs=1e-9)
 
 
 @pytest.mark.parametrize("n", [0, 5, 7, -1])

@@ -17,7 +17,11 @@ import numpy as np
 from tqdm import tqdm
 
 from twin import report
-from twin.reference import THESIS_SIMULATED_RMSE_DEG, THESIS_SIMULATED_SSE_T1_DEG
+from twin.reference import (
+    THESIS_SIMULATED_RMSE_DEG,
+    THESIS_SIMULATED_SSE_T1_DEG,
+    THESIS_SIMULATED_T4_REST_ERRORS_DEG,
+)
 from twin.runner import run_many
 from twin.scenario import CONTROLLER_NAMES, TRAJECTORY_NUMBERS, Scenario
 from twin.simulation import Result
@@ -38,7 +42,7 @@ def summary_rows(results: list[Result]) -> list[dict]:
             records = [report.summary(r) for r in results
                        if r.scenario.controller == c and r.scenario.trajectory == t]
             rmse = np.array([r["rmse_deg"] for r in records])
-            sse = np.array([r["sse_deg"] for r in records])
+            sse = np.array([np.nan if r["sse_deg"] is None else r["sse_deg"] for r in records])
             peak = np.array([r["max_error_deg"] for r in records])
             thesis = THESIS_SIMULATED_RMSE_DEG.get(c, {}).get(t)
             rows.append({
@@ -56,6 +60,26 @@ def _fmt(value, spec: str = ".2f") -> str:
     return "–" if value is None else format(value, spec)
 
 
+def _sse(row: dict) -> str:
+    if np.isnan(row["sse_mean"]):
+        return "– (ends moving)"
+    return f"{row['sse_mean']:+.2f} [{row['sse_min']:+.2f}, {row['sse_max']:+.2f}]"
+
+
+def rest_error_table(results: list[Result]) -> str:
+    """T4's errors at the end of its four rests, seed mean, beside the thesis's simulated ones."""
+    lines = ["| controller | T4 rest errors (deg), twin mean over seeds | thesis sim |", "|---|---|---|"]
+    for c in CONTROLLER_NAMES:
+        runs = [r for r in results if r.scenario.controller == c and r.scenario.trajectory == 4]
+        if not runs:
+            continue
+        mean = np.degrees(np.mean([r.metrics.rest_errors for r in runs], axis=0))
+        thesis = THESIS_SIMULATED_T4_REST_ERRORS_DEG.get(c)
+        lines.append(f"| {LABELS[c]} | {', '.join(f'{e:+.2f}' for e in mean)} | "
+                     f"{', '.join(f'{e:+.2f}' for e in thesis) if thesis else '–'} |")
+    return "\n".join(lines)
+
+
 def markdown_table(rows: list[dict]) -> str:
     lines = ["| controller | traj | RMSE (deg) mean ± std | thesis sim RMSE | diff | SSE mean [min, max] | thesis SSE | max \\|e\\| mean |",
              "|---|---|---|---|---|---|---|---|"]
@@ -63,7 +87,7 @@ def markdown_table(rows: list[dict]) -> str:
         diff = None if r["thesis_rmse"] is None else r["rmse_mean"] - r["thesis_rmse"]
         lines.append(
             f"| {LABELS[r['controller']]} | T{r['trajectory']} | {r['rmse_mean']:.2f} ± {r['rmse_std']:.2f} | "
-            f"{_fmt(r['thesis_rmse'])} | {_fmt(diff, '+.2f')} | {r['sse_mean']:+.2f} [{r['sse_min']:+.2f}, {r['sse_max']:+.2f}] | "
+            f"{_fmt(r['thesis_rmse'])} | {_fmt(diff, '+.2f')} | {_sse(r)} | "
             f"{_fmt(r['thesis_sse'])} | {r['max_error_mean']:.2f} |")
     return "\n".join(lines)
 
@@ -85,12 +109,13 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
         for result in results:
             record = report.summary(result)
             record["warnings"] = ";".join(record["warnings"])
+            record["rest_errors_deg"] = ";".join(f"{e:.4f}" for e in record["rest_errors_deg"])
             if writer is None:
                 writer = csv.DictWriter(handle, fieldnames=list(record))
                 writer.writeheader()
             writer.writerow(record)
     rows = summary_rows(results)
-    table = markdown_table(rows)
+    table = markdown_table(rows) + "\n\n" + rest_error_table(results)
     (out / "summary.md").write_text(
         f"# Thesis controller comparison on the twin ('thesis' plant, {seeds} seeds)\n\n{table}\n")
     if plots:

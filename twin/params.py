@@ -48,6 +48,9 @@ class GearParams:
     diametral_pitch: float = 48.0  # teeth per inch
     pinion_face_width: float = 0.125 * 0.0254  # m
     spur_face_width: float = 0.0625 * 0.0254  # m
+    safe_bending_stress: float = 12_000 * 6894.757  # Pa, S = 12,000 psi, brass (eq. 3.5.4)
+    pinion_form_factor: float = 0.176  # Y, Lewis (eq. 3.5.4)
+    spur_form_factor: float = 0.270  # Y, Lewis (eq. 3.5.4)
 
     def __post_init__(self) -> None:
         _require_positive(self, "pinion_pitch_diameter", "spur_pitch_diameter", "diametral_pitch")
@@ -60,6 +63,11 @@ class GearParams:
     def spur_radius(self) -> float:
         """r_s: theta = y / r_s (eq. 3.4.1, 12.03 deg/mm)."""
         return self.spur_pitch_diameter / 2.0  # m
+
+    @property
+    def diametral_pitch_si(self) -> float:
+        """P_d in teeth per metre of pitch diameter."""
+        return self.diametral_pitch / 0.0254  # 1/m
 
     @property
     def ratio(self) -> float:
@@ -101,6 +109,7 @@ class ValveParams:
     """On/off solenoid valves, pulse-width-modulated (§3) and eq. 4.4.2."""
 
     pwm_period: float = 16e-3  # s, 62.5 Hz
+    switching_period: float = 1e-3  # s, the DAQ's output tick (§5, §6): duties realised in whole ticks; 0 = continuous
     opening_delay: float = 5e-3  # s
     closing_delay: float = 2e-3  # s
     dead_zone_duty: float = 30.0  # %, below it the real valve does not open
@@ -111,6 +120,8 @@ class ValveParams:
         _require_positive(self, "pwm_period", "resistance_coefficient")
         if self.opening_delay < 0 or self.closing_delay < 0:
             raise InvalidParameter("valve delays must be non-negative")
+        if self.switching_period < 0 or self.switching_period > self.pwm_period:
+            raise InvalidParameter(f"switching_period must be in [0, pwm_period], got {self.switching_period}")
         if not 0.0 <= self.dead_zone_duty < 100.0:
             raise InvalidParameter(f"dead_zone_duty must be in [0, 100) %, got {self.dead_zone_duty}")
 

@@ -8,6 +8,7 @@ THESIS_SIMULATED_RMSE_DEG = {
     "smc": {1: 0.86, 2: 0.99, 3: 1.26, 4: 0.94},
 }
 THESIS_SIMULATED_SSE_T1_DEG = {"ffpva": 0.35, "smc": 0.53}
+THESIS_SIMULATED_T4_REST_ERRORS_DEG = {"ffpva": (0.35, 1.21, -1.39, 0.40), "smc": (0.53, -0.58, 0.39, -0.17)}
 
 # Experiment, horizontal, no payload: mean RMSE and std over 5 runs (§8).
 THESIS_EXPERIMENT_RMSE_DEG = {

@@ -6,12 +6,21 @@ controller protocol); the CLI and the studies call it.
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Callable, Sequence
 
 from controllers import make_controller
 from controllers.feedforward import NominalModel
+from twin.params import NOMINAL_PARAMS
 from twin.scenario import Scenario
 from twin.simulation import Result, simulate
+
+
+def nominal_model(preset) -> NominalModel:
+    """The controllers' model: always the thesis's numbers (SPEC), whatever the plant, so that a
+    plant's model errors stay model errors; only the PWM period follows the plant's valves."""
+    valves = dataclasses.replace(NOMINAL_PARAMS.valves, pwm_period=preset.params.valves.pwm_period)
+    return NominalModel.thesis(dataclasses.replace(NOMINAL_PARAMS, valves=valves))
 
 
 def thesis_controllers(scenarios: Sequence[Scenario]) -> list:
@@ -21,7 +30,7 @@ def thesis_controllers(scenarios: Sequence[Scenario]) -> list:
     chosen = []
     for s in scenarios:
         preset = s.preset
-        key = (s.controller, preset.gain_set, NominalModel.thesis(preset.params), preset.timestep)
+        key = (s.controller, preset.gain_set, nominal_model(preset), preset.timestep)
         if key not in shared:
             shared[key] = make_controller(s.controller, nominal=key[2], gain_set=key[1], tick=key[3])
         chosen.append(shared[key])

@@ -136,6 +136,9 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         controller_groups.append((controller, idx, whole_ticks(controller.period, h, what="controller period")))
 
     duty = np.zeros(n)
+    failures: dict[int, str] = {}
+    active = np.flatnonzero(lengths > 1)  # scenario i is stepped at ticks 0 .. lengths[i] - 2
+    ends = {int(length) for length in lengths}
     rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "fs", "fa", "fb")}
     valve_open = np.zeros((n, ticks, 4), dtype=bool)
     for k in range(ticks):
@@ -154,7 +157,14 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         rec["pa"][:, k] = plant.pressure_a
         rec["pb"][:, k] = plant.pressure_b
         valve_open[:, k] = plant.conductance > 0
-        batch.step(stage=int(mujoco.mjtStage.mjSTAGE_VEL))  # derived fields (gravity) at the new state
+        if k + 1 in ends:
+            active = active[lengths[active] > k + 1]
+        try:  # derived fields (gravity) at the new state; a finished scenario stops here
+            batch.step(ids=active, stage=int(mujoco.mjtStage.mjSTAGE_VEL))
+        except mujoco.batch.SimulationError as error:
+            for i in error.ids:
+                failures[int(i)] = f"MuJoCo error at t = {k * h:.3f} s: {batch.error(int(i))}"
+            active = np.array([i for i in active if int(i) not in failures], dtype=int)
         # Constraint forces of this step (computed at tick k's state; not refreshed by the stage above).
         rec["fs"][:, k] = np.abs(qfrc_constraint[:, dof.spur_dof]) / spur_radius
         rec["fa"][:, k] = np.abs(qfrc_constraint[:, dof.rack_a_dof])
@@ -169,6 +179,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         theta = rec["theta"][i, :T]
         desired = y_d[i, :T] / spur_radius[i]
         warnings = _warnings(batch.get_data(i))
+        if i in failures:
+            warnings += (failures[i],)
         if not np.all(np.isfinite(theta)):
             warnings += ("state is not finite",)
         trace = Trace(
@@ -179,6 +191,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
             tooth_force_spur=rec["fs"][i, :T], tooth_force_rack_a=rec["fa"][i, :T],
             tooth_force_rack_b=rec["fb"][i, :T],
         )
-        results.append(Result(scenario=s, trace=trace, metrics=tracking_metrics(desired, theta),
-                              warnings=warnings, wall_time=wall))
+        tr_i = trajectories[i]
+        metrics = tracking_metrics(desired, theta, ends_at_rest=tr_i.ends_at_rest,
+                                   rest_end_ticks=[int(round(e / h)) - 1 for e in tr_i.rest_ends()])
+        results.append(Result(scenario=s, trace=trace, metrics=metrics, warnings=warnings, wall_time=wall))
     return results

@@ -46,7 +46,7 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
     for key, members in groups.items():
         ok = [r for r in members if r["status"] == "ok"]
         rmse = np.array([r["rmse_deg"] for r in ok]) if ok else np.array([math.nan])
-        sse = np.array([r["sse_deg"] for r in ok]) if ok else np.array([math.nan])
+        sse = np.array([math.nan if r["sse_deg"] is None else r["sse_deg"] for r in ok]) if ok else np.array([math.nan])
         summary.append({
             **dict(zip(GROUP_BY, key, strict=True)), "runs": len(members), "failed": len(members) - len(ok),
             "rmse_mean_deg": float(np.mean(rmse)), "rmse_std_deg": float(np.std(rmse, ddof=1)) if len(ok) > 1 else 0.0,

@@ -2,18 +2,19 @@
 
 Angles are the output angle theta = y / r_s. Start angles and holds that the
 thesis does not state are chosen inside the friction fit's range
-(y = 2 - 14.5 mm, i.e. 24 - 174 deg) and written down here:
+(y = 2 - 14.5 mm, i.e. 24 - 174 deg) where SPEC allows and written down here:
 
 ==  =======  =========  ==========================================================
 #   start    duration   shape
 ==  =======  =========  ==========================================================
-T1  20 deg   3.0 s      +120 deg cycloid in 1 s, hold 2 s
-T2  20 deg   2.0 s      ramp at 10 mm/s rack speed to 140 deg (0.998 s), hold to 2 s
-T3  80 deg   4.0 s      80 + 60 sin(pi t) deg: 0.5 Hz, 20 - 140 deg, two periods,
-                        starting mid-stroke at full speed (the thesis reports its
-                        largest error at the start of T3)
-T4  20 deg   6.0 s      +120 (1 s), rest 1, -120 (1 s), rest 0.5, +60 (0.5 s),
-                        rest 0.5, -60 (0.5 s), rest 1
+T1  30 deg   3.0 s      +120 deg cycloid in 1 s to 150 deg, hold 2 s
+T2  30 deg   2.0 s      ramp at 10 mm/s rack speed to 150 deg (0.998 s), hold to 2 s
+T3  80 deg   4.0 s      80 + 60 sin(pi t) deg: 0.5 Hz, 20 - 140 deg as SPEC §7 says
+                        (so it dips below the fit), two periods, starting mid-stroke
+                        at full speed (the thesis reports its largest error at the
+                        start of T3); it ends moving, so it has no steady error
+T4  30 deg   6.0 s      +120 (1 s), rest 1, -120 (1 s), rest 0.5, +60 (0.5 s),
+                        rest 0.5, -60 (0.5 s), rest 1: 30, 150, 30, 90, 30 deg
 ==  =======  =========  ==========================================================
 
 The cycloidal rise (eqs. 5.2.5 - 5.2.7) of height H over T:
@@ -59,6 +60,19 @@ class Trajectory:
     def duration(self) -> float:
         return sum(s.duration for s in self.segments)  # s
 
+    @property
+    def ends_at_rest(self) -> bool:
+        return self.segments[-1].kind == "rest"
+
+    def rest_ends(self) -> list[float]:
+        """Times (s) at which each rest segment ends: where the thesis reads its steady errors."""
+        ends, clock = [], 0.0
+        for seg in self.segments:
+            clock += seg.duration
+            if seg.kind == "rest":
+                ends.append(clock)
+        return ends
+
     def sample(self, t: np.ndarray, spur_radius: float) -> Reference:
         """The reference at times ``t`` (s), as rack motion (y = theta r_s)."""
         theta = np.full_like(t, self.start)
@@ -98,22 +112,25 @@ def _deg(x: float) -> float:
     return math.radians(x)
 
 
+START = math.radians(30.0)  # rad, T1, T2 and T4: inside the friction fit (y = 2.49 mm)
+
+
 def _t2(spur_radius: float) -> Trajectory:
     rise = _deg(120.0)
     ramp_time = rise * spur_radius / RAMP_SPEED
-    return Trajectory(2, _deg(20.0), (Segment("ramp", ramp_time, rise), Segment("rest", 2.0 - ramp_time)))
+    return Trajectory(2, START, (Segment("ramp", ramp_time, rise), Segment("rest", 2.0 - ramp_time)))
 
 
 def trajectory(number: int, *, spur_radius: float) -> Trajectory:
     """T1..T4 of §7."""
     if number == 1:
-        return Trajectory(1, _deg(20.0), (Segment("cycloid", 1.0, _deg(120.0)), Segment("rest", 2.0)))
+        return Trajectory(1, START, (Segment("cycloid", 1.0, _deg(120.0)), Segment("rest", 2.0)))
     if number == 2:
         return _t2(spur_radius)
     if number == 3:
         return Trajectory(3, _deg(80.0), (Segment("sine", 4.0, _deg(60.0)),))
     if number == 4:
-        return Trajectory(4, _deg(20.0), (
+        return Trajectory(4, START, (
             Segment("cycloid", 1.0, _deg(120.0)), Segment("rest", 1.0),
             Segment("cycloid", 1.0, _deg(-120.0)), Segment("rest", 0.5),
             Segment("cycloid", 0.5, _deg(60.0)), Segment("rest", 0.5),

@@ -12,6 +12,11 @@ Two named valve models, both with the opening and closing delays of §3:
     The discharge valve is a steady resistance R(|u|) of eq. 4.4.2 for the
     whole PWM period: the PWM is averaged out. Commands with |u| below
     ``dead_zone_duty`` leave the valve shut.
+Both realise the duty in whole switching periods (``switching_period``, the
+DAQ's 1 ms output tick: 6.25 % steps of a 16 ms period); a duty under half a
+step sends no pulse. ``switching_period = 0`` makes the averaged valve
+continuous (a sensitivity variant).
+
 ``pwm`` (time-resolved)
     Each valve is either shut or fully open (R(100 %)); the discharge valve's
     coil is on for the first |u| x period of each period. A pulse shorter than
@@ -59,6 +64,13 @@ class ValveBank:
         if abs(self.open_ticks * tick - params.opening_delay) > 1e-12 or abs(self.close_ticks * tick - params.closing_delay) > 1e-12:
             raise InvalidScenario("valve delays must be whole numbers of ticks")
         self.full_conductance = 1.0 / params.open_resistance
+        if params.switching_period > 0:
+            self.duty_steps = whole_ticks(params.pwm_period, params.switching_period, what="PWM period")
+            whole_ticks(params.switching_period, tick, what="valve switching period")
+        elif model is ValveModel.PWM:
+            raise InvalidScenario("the time-resolved PWM valve needs a switching period")
+        else:
+            self.duty_steps = 0  # continuous duty
         self._on_run = np.zeros((n, 4), dtype=np.int64)  # ticks the coil has been on, this one included
         self._off_run = np.full((n, 4), 1 << 30, dtype=np.int64)
         self._open = np.zeros((n, 4), dtype=bool)
@@ -73,14 +85,15 @@ class ValveBank:
     def _coil_conductance(self, tick: int, duty: np.ndarray) -> np.ndarray:
         """Conductance each valve would have with no delay, (n, 4)."""
         magnitude = np.minimum(np.abs(duty), 100.0)
-        # The coil switches only on tick boundaries: a period of P ticks realises duties in 100/P % steps.
-        on_ticks = np.rint(magnitude / 100.0 * self.period_ticks)
-        realised = on_ticks * (100.0 / self.period_ticks)
-        energised = (on_ticks > 0) & (magnitude >= self.params.dead_zone_duty)
+        if self.duty_steps:  # the coil switches on the DAQ's tick: a period of S ticks realises duties in 100/S % steps
+            realised = np.rint(magnitude / 100.0 * self.duty_steps) * (100.0 / self.duty_steps)
+        else:
+            realised = magnitude
+        energised = (realised > 0) & (magnitude >= self.params.dead_zone_duty)
         if self.model is ValveModel.AVERAGED:
             drain = np.where(energised, 1.0 / self.params.resistance(np.maximum(realised, 1e-9)), 0.0)
         else:
-            in_pulse = (tick % self.period_ticks) < on_ticks
+            in_pulse = (tick % self.period_ticks) < np.rint(realised / 100.0 * self.period_ticks)
             drain = np.where(energised & in_pulse, self.full_conductance, 0.0)
         supply = np.where(energised, self.full_conductance, 0.0)
         forward, backward = duty > 0, duty < 0

@@ -33,7 +33,8 @@ def plot_run(result: Result, path: pathlib.Path) -> None:
     axes[1].axhline(0.0, color="0.6", lw=0.6)
     axes[1].set_ylabel("error (deg)")
     m = result.metrics
-    axes[1].set_title(f"RMSE {math.degrees(m.rmse):.2f} deg   SSE {math.degrees(m.sse):.2f} deg   "
+    sse = "–" if math.isnan(m.sse) else f"{math.degrees(m.sse):.2f} deg"
+    axes[1].set_title(f"RMSE {math.degrees(m.rmse):.2f} deg   SSE {sse}   "
                       f"max |e| {math.degrees(m.max_error):.2f} deg", fontsize=9)
     axes[2].step(tr.time, tr.duty, "C2", lw=1.0, where="post")
     axes[2].set_ylabel("duty (%)")
