@@ -9,6 +9,7 @@ import pathlib
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from twin.report import TRACE_COLUMNS
@@ -65,6 +66,11 @@ BASE = ["run", "--controller", "ffpva", "--trajectory", "1"]
     (BASE + ["--trace", "no_such_folder/x.csv"], "no_such_folder"),
     (BASE + ["--plot", "no_such_folder/x.png"], "no_such_folder"),
     (BASE + ["--trace", "ok.csv", "--plot", "no_such_folder/x.png"], "no_such_folder"),
+    (BASE + ["--trace", "ok.csv", "--plot", "figure.txt"], "figure.txt"),
+    (BASE + ["--payload", "500"], "500 g"),
+    (["demo", "--seeds", "0"], "'0'"),
+    (["sweep", "--payload", "heavy", "--out", "x"], "heavy"),
+    (["sweep", "--controller", "ffpva"], "--out"),
 ])
 def test_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, args, bad):
     proc = twin(tmp_path, *args)
@@ -95,10 +101,35 @@ def test_trace_and_plot_files(tmp_path):
     assert (tmp_path / "out.png").read_bytes()[:8] == PNG_MAGIC
 
 
-def test_without_noise_two_runs_are_identical(tmp_path):
-    first = run_json(tmp_path, "--no-noise", "--seed", "0")
-    second = run_json(tmp_path, "--no-noise", "--seed", "0")
-    assert first == second
+def _trace(tmp_path, *args):
+    proc = twin(tmp_path, "run", "--controller", "ffpva", "--trajectory", "2", "--trace", "t.csv", *args)
+    assert proc.returncode == 0, proc.stderr
+    with open(tmp_path / "t.csv", newline="") as handle:
+        rows = list(csv.DictReader(handle))
+    return np.array([float(r["y_measured_mm"]) - float(r["y_mm"]) for r in rows])
+
+
+def test_no_noise_means_the_sensor_reads_the_true_position(tmp_path):
+    assert np.all(_trace(tmp_path, "--no-noise") == 0.0)
+
+
+def test_noise_is_white_within_the_thesis_bound(tmp_path):
+    noise = _trace(tmp_path, "--seed", "4")
+    assert np.max(np.abs(noise)) <= 0.02 + 1e-6  # mm, SPEC §5 (the CSV keeps 6 digits)
+    assert np.std(noise) == pytest.approx(0.02 / np.sqrt(3), rel=0.1)  # uniform on +-0.02 mm
+    assert abs(np.corrcoef(noise[:-1], noise[1:])[0, 1]) < 0.1  # white
+
+
+def test_a_run_with_a_mujoco_warning_exits_1(monkeypatch, capsys):
+    import dataclasses
+
+    import twin.cli
+    import twin.runner
+
+    real = twin.runner.run
+    monkeypatch.setattr(twin.runner, "run", lambda s: dataclasses.replace(real(s), warnings=("mjWARN_BADQACC x1",)))
+    assert twin.cli.main(["run", "--controller", "ffpva", "--trajectory", "2"]) == 1
+    assert "mjWARN_BADQACC" in capsys.readouterr().out
 
 
 def test_noise_seed_changes_the_result(tmp_path):

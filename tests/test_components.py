@@ -266,3 +266,19 @@ def test_valid_defaults_construct():
     assert dataclasses.is_dataclass(joint)
     assert joint.cylinder.bore_area == pytest.approx(AREA, rel=1e-12)
     assert joint.gears.spur_radius == pytest.approx(R_SPUR, rel=1e-12)
+
+
+def test_feedforward_accounts_for_the_desired_acceleration():
+    """R4 = [P A - s (M a_d + F_l) - R1 A^2 |v_d|] / (A^2 |v_d|), d = (R4 / c)^(1 / -2.1706) (eq. 5.3.2-5.3.3)."""
+    model = NominalModel.thesis()
+    A, y, v, a = model.bore_area, 8e-3, 10e-3, 2.0
+    loss = float(coulomb_force(model.friction, np.array([y]), np.array([1.0]))[0]) + model.friction.viscous * v
+    for sign in (1.0, -1.0):
+        r4 = (model.supply_pressure * A - sign * (model.mass * sign * a + sign * loss)
+              - model.valves.open_resistance * A**2 * v) / (A**2 * v)
+        expected = sign * (r4 / 1.8372e14) ** (1 / -2.1706)
+        got = feedforward_duty(model, np.array([y]), np.array([sign * v]), np.array([sign * a]))[0]
+        assert got == pytest.approx(expected, rel=1e-12)
+    accelerating = feedforward_duty(model, np.array([y]), np.array([v]), np.array([a]))[0]
+    cruising = feedforward_duty(model, np.array([y]), np.array([v]), np.array([0.0]))[0]
+    assert accelerating > cruising  # more force needed: less resistance, more duty

@@ -13,6 +13,7 @@ from __future__ import annotations
 import argparse
 import json
 import math
+import os
 import pathlib
 import sys
 
@@ -29,13 +30,21 @@ class _Parser(argparse.ArgumentParser):
         self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
 
 
-def _writable_file(text: str) -> pathlib.Path:
-    path = pathlib.Path(text)
-    if not path.parent.exists():
-        raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
-    if path.is_dir():
-        raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
-    return path
+def _writable_file(suffix: str):
+    """An argparse type for an output file with ``suffix`` in an existing, writable folder."""
+    def check(text: str) -> pathlib.Path:
+        path = pathlib.Path(text)
+        if path.suffix.lower() != suffix:
+            raise argparse.ArgumentTypeError(f"{text!r} must end in {suffix}")
+        if not path.parent.is_dir():
+            raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} of {text!r} does not exist")
+        if path.is_dir():
+            raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+        if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+            raise argparse.ArgumentTypeError(f"cannot write {text!r}")
+        return path
+
+    return check
 
 
 def _checked(kind: type, accept, requirement: str):
@@ -169,7 +178,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
 
     demo = sub.add_parser("demo", help="reproduce the thesis's simulated controller comparison")
-    demo.add_argument("--out", type=pathlib.Path, default=pathlib.Path("twin-demo"),
+    demo.add_argument("--out", type=_out_dir, default=pathlib.Path("twin-demo"),
                       help="output folder (created; default ./twin-demo)")
     demo.add_argument("--seeds", type=_positive_int, default=5, help="noise seeds per case (default 5)")
     demo.add_argument("--plots", action=argparse.BooleanOptionalAction, default=True)
@@ -192,8 +201,8 @@ def build_parser() -> argparse.ArgumentParser:
 
     run = sub.add_parser("run", help="simulate one scenario")
     add_scenario_arguments(run)
-    run.add_argument("--trace", type=_writable_file, metavar="FILE.csv", help="write the time series")
-    run.add_argument("--plot", type=_writable_file, metavar="FILE.png", help="write a figure")
+    run.add_argument("--trace", type=_writable_file(".csv"), metavar="FILE.csv", help="write the time series")
+    run.add_argument("--plot", type=_writable_file(".png"), metavar="FILE.png", help="write a figure")
     run.add_argument("--json", action="store_true", help="print exactly one JSON object")
     run.set_defaults(func=_cmd_run)
     return parser
@@ -205,6 +214,9 @@ def main(argv: list[str] | None = None) -> int:
         return args.func(args)
     except TwinError as error:
         print(f"twin: error: {error}", file=sys.stderr)
+        return EXIT_USAGE
+    except OSError as error:  # an output that passed the checks but still cannot be written
+        print(f"twin: error: cannot write {error.filename or ''}: {error.strerror}", file=sys.stderr)
         return EXIT_USAGE
 
 

@@ -131,7 +131,10 @@ def compile_joint(*, params: JointParams = NOMINAL_PARAMS, payload_mass: float =
                   orientation: Orientation = Orientation.HORIZONTAL, timestep: float = 1e-3) -> JointModel:
     """Compile the joint; see :func:`build_mjcf`. ``payload_mass`` in kg."""
     root = build_mjcf(params=params, payload_mass=payload_mass, orientation=orientation, timestep=timestep)
-    model = mujoco.MjModel.from_xml_string(root.to_xml_string(), root.get_assets())
+    try:
+        model = mujoco.MjModel.from_xml_string(root.to_xml_string(), root.get_assets())
+    except ValueError as error:
+        raise InvalidScenario(f"MuJoCo rejected the joint model: {error}") from None
     dofs = [int(model.jnt_dofadr[model.joint(name).id]) for name in MECHANISM_JOINTS]
     r_p, r_s = params.gears.pinion_radius, params.gears.spur_radius
     manifold = np.zeros(model.nv)

@@ -12,6 +12,9 @@ controllers use on it.
 ``thesis-deadzone``
     The same with the real valve's 30 % dead zone (§3): commands below 30 %
     leave the valve shut. A sensitivity variant, not a reproduction target.
+``thesis-continuous``
+    The ``thesis`` plant with a continuous duty (no 1 ms switching tick): what
+    an ideal averaged valve would do. A sensitivity variant.
 ``thesis-pwm``
     The same with the time-resolved PWM valve: each valve shut or fully open,
     16 ms period, delays and 30 % dead zone.
@@ -44,6 +47,8 @@ PLANTS = {
     "thesis": Plant("thesis", _THESIS_PARAMS, ValveModel.AVERAGED, "simulation"),
     "thesis-deadzone": Plant("thesis-deadzone", dataclasses.replace(_THESIS_PARAMS, valves=ValveParams()),
                              ValveModel.AVERAGED, "simulation"),
+    "thesis-continuous": Plant("thesis-continuous", dataclasses.replace(
+        _THESIS_PARAMS, valves=ValveParams(dead_zone_duty=0.0, switching_period=0.0)), ValveModel.AVERAGED, "simulation"),
     "thesis-pwm": Plant("thesis-pwm", dataclasses.replace(_THESIS_PARAMS, valves=ValveParams()),
                         ValveModel.PWM, "simulation"),
 }

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import numbers
 
 from twin.exceptions import InvalidScenario
 from twin.model import MAX_PAYLOAD, Orientation
@@ -30,8 +31,10 @@ class Scenario:
             raise InvalidScenario(f"unknown controller {self.controller!r}: choose one of {', '.join(CONTROLLER_NAMES)}")
         if self.trajectory not in TRAJECTORY_NUMBERS:
             raise InvalidScenario(f"unknown trajectory {self.trajectory!r}: choose 1, 2, 3 or 4")
-        if not isinstance(self.payload, (int, float)) or not math.isfinite(self.payload) or not 0 <= self.payload <= MAX_PAYLOAD:
-            raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, got {self.payload!r} kg")
+        if not isinstance(self.payload, numbers.Real) or not math.isfinite(self.payload) \
+                or not 0 <= self.payload <= MAX_PAYLOAD:
+            shown = f"{self.payload * 1e3:g} g" if isinstance(self.payload, numbers.Real) else repr(self.payload)
+            raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, got {shown}")
         if not isinstance(self.orientation, Orientation):
             raise InvalidScenario(f"orientation must be an Orientation, got {self.orientation!r}")
         if self.pwm_period is not None:
@@ -42,7 +45,7 @@ class Scenario:
                 raise InvalidScenario(f"PWM period must be a whole number of {base.timestep * 1e3:g} ms ticks "
                                       f"between 4 and 100 ticks, got {self.pwm_period * 1e3:g} ms")
         preset = self.preset
-        if not isinstance(self.seed, int) or self.seed < 0:
+        if not isinstance(self.seed, numbers.Integral) or isinstance(self.seed, bool) or self.seed < 0:
             raise InvalidScenario(f"seed must be a non-negative integer, got {self.seed!r}")
         if self.supply_pressure is not None:
             rated = preset.params.cylinder.rated_pressure
