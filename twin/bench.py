@@ -9,6 +9,8 @@ second, with their ratios. Timings on a shared machine are noisy: compare the ra
 from __future__ import annotations
 
 import dataclasses
+import os
+import pathlib
 import time
 
 import mujoco
@@ -25,6 +27,8 @@ class Bench:
     twin_batch: float  # wall s per simulated scenario-second, batch of `batch_size`
     batch_size: int
     env_single: float  # wall s per simulated s, the dm_control environment, same scenario and policy
+    sweep_walls: dict  # workers -> wall s of the same sweep
+    sweep_scenario_seconds: float  # simulated scenario-seconds in that sweep
 
     def lines(self) -> list[str]:
         return [
@@ -36,6 +40,13 @@ class Bench:
             f"per simulated s of the whole batch)",
             f"dm_control env, 1 run: {self.env_single * 1e3:8.2f} ms per simulated s "
             f"({self.env_single / self.twin_single:.2f}x the twin's own loop)",
+        ] + [
+            f"sweep of {self.sweep_scenario_seconds:.0f} scenario-s, {w} worker{'s' if w > 1 else ''}: {wall:6.2f} s wall "
+            f"= {wall / self.sweep_scenario_seconds * 1e3:.2f} ms per scenario-s "
+            f"({wall / self.sweep_scenario_seconds / self.bare_step:.2f}x bare mj_step on one core; "
+            f"{wall * w / self.sweep_scenario_seconds / self.bare_step:.2f}x per core used; "
+            f"speed-up {self.sweep_walls[1] / wall:.2f}x over 1 worker)"
+            for w, wall in self.sweep_walls.items()
         ]
 
 
@@ -48,7 +59,28 @@ def _bare_step_cost(seconds: float) -> float:
     return (time.perf_counter() - start) / seconds
 
 
-def measure(*, batch_size: int = 100, trajectory: int = 1) -> Bench:
+def _sweep_walls(workers: int) -> tuple[dict, float]:
+    """The 360-scenario thesis grid (3 controllers x 4 trajectories x 3 payloads x 2 orientations x 5 seeds),
+    timed end to end (workers start, run, store) with 1 worker and with ``workers``."""
+    import tempfile
+
+    from twin.grid import expand
+    from twin.sweep import run_sweep
+    from twin.trajectories import trajectory
+
+    points = expand({"controller": ["pva", "ffpva", "smc"], "trajectory": [1, 2, 3, 4], "payload": [0.0, 6.5, 13.5],
+                     "orientation": ["horizontal", "vertical"], "seed": list(range(5))})
+    scenario_seconds = sum(trajectory(p.trajectory, spur_radius=1.0).duration for p in points)
+    walls = {}
+    for count in sorted({1, workers}):
+        with tempfile.TemporaryDirectory() as out:
+            start = time.perf_counter()
+            run_sweep(points, out=pathlib.Path(out), workers=count)
+            walls[count] = time.perf_counter() - start
+    return walls, scenario_seconds
+
+
+def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None) -> Bench:
     scenario = Scenario("ffpva", trajectory)
     run_many([scenario])  # warm caches (model compile, imports)
     start = time.perf_counter()
@@ -59,8 +91,10 @@ def measure(*, batch_size: int = 100, trajectory: int = 1) -> Bench:
     start = time.perf_counter()
     run_many(batch)
     twin_batch = (time.perf_counter() - start) / (duration * batch_size)
+    walls, scenario_seconds = _sweep_walls(workers or os.cpu_count() or 1)
     return Bench(bare_step=_bare_step_cost(duration * 10), twin_single=twin_single,
-                 twin_batch=twin_batch, batch_size=batch_size, env_single=_env_cost(trajectory, duration))
+                 twin_batch=twin_batch, batch_size=batch_size, env_single=_env_cost(trajectory, duration),
+                 sweep_walls=walls, sweep_scenario_seconds=scenario_seconds)
 
 
 def _env_cost(trajectory: int, duration: float) -> float:

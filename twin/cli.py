@@ -119,7 +119,7 @@ def _cmd_demo(args: argparse.Namespace) -> int:
 def _cmd_bench(args: argparse.Namespace) -> int:
     from twin.bench import measure
 
-    for line in measure(batch_size=args.batch).lines():
+    for line in measure(batch_size=args.batch, workers=args.workers).lines():
         print(line)
     return 0
 
@@ -173,6 +173,44 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+def _cmd_whatif(args: argparse.Namespace) -> int:
+    import csv
+
+    from tqdm import tqdm
+
+    from twin import grid, whatif
+    from viz.whatif_plots import PLOTS
+
+    args.out.mkdir(exist_ok=True)
+    store = args.out / f"{args.study}-runs"
+    if args.study in ("payload", "pwm"):
+        store.mkdir(exist_ok=True)
+    with tqdm(unit="scenario", file=sys.stderr, dynamic_ncols=True, desc=args.study) as bar:
+        if args.study == "payload":
+            study = whatif.payload_study(out=store, payloads_g=grid.parse_axis("payload", args.payloads),
+                                         trajectory=args.trajectory, seeds=args.seeds, plant_name=args.plant,
+                                         workers=args.workers, progress=bar.update)
+        elif args.study == "pwm":
+            study = whatif.pwm_study(out=store, periods_ms=grid.parse_axis("pwm_period_ms", args.periods),
+                                     seeds=args.seeds, plant_name=args.plant, workers=args.workers,
+                                     progress=bar.update)
+        elif args.study == "lift":
+            study = whatif.lift_study(pressures_kpa=grid.parse_axis("supply_kpa", args.pressures),
+                                      plant_name=args.plant)
+        else:
+            study = whatif.gear_load_study(plant_name=args.plant)
+    stem = args.out / args.study
+    with open(stem.with_suffix(".csv"), "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(study.rows[0]))
+        writer.writeheader()
+        writer.writerows(study.rows)
+    PLOTS[args.study](study.rows, stem.with_suffix(".png"))
+    stem.with_suffix(".txt").write_text(study.answer + "\n")
+    print(study.answer)
+    print(f"wrote {stem.with_suffix('.csv')}, {stem.with_suffix('.png')}, {stem.with_suffix('.txt')}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="twin", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -186,6 +224,7 @@ def build_parser() -> argparse.ArgumentParser:
 
     bench = sub.add_parser("bench", help="cost per simulated second, as ratios to bare mj_step")
     bench.add_argument("--batch", type=_positive_int, default=100, help="runs in the batched case (default 100)")
+    bench.add_argument("--workers", type=_positive_int, default=None, help="sweep workers (default: all cores)")
     bench.set_defaults(func=_cmd_bench)
 
     sweep = sub.add_parser("sweep", help="a grid of scenarios on all cores (or Ray), resumable")
@@ -198,6 +237,18 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--backend", choices=("local", "ray"), default="local")
     sweep.add_argument("--ray-address", default=None, help="Ray cluster address (default: RAY_ADDRESS or local)")
     sweep.set_defaults(func=_cmd_sweep)
+
+    whatif = sub.add_parser("whatif", help="payload, lift, PWM and gear-load studies")
+    whatif.add_argument("study", choices=("payload", "lift", "pwm", "gear-load"))
+    whatif.add_argument("--out", type=_out_dir, required=True, metavar="DIR")
+    whatif.add_argument("--plant", choices=sorted(PLANTS), default="thesis")
+    whatif.add_argument("--payloads", default="0:30:2.5", metavar="LIST", help="grams (payload study)")
+    whatif.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), default=1, help="payload study")
+    whatif.add_argument("--pressures", default="100:700:50", metavar="LIST", help="kPa (lift study)")
+    whatif.add_argument("--periods", default="8:32:4", metavar="LIST", help="PWM periods in ms (pwm study)")
+    whatif.add_argument("--seeds", type=_positive_int, default=3)
+    whatif.add_argument("--workers", type=_positive_int, default=None)
+    whatif.set_defaults(func=_cmd_whatif)
 
     run = sub.add_parser("run", help="simulate one scenario")
     add_scenario_arguments(run)

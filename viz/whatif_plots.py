@@ -1,0 +1,67 @@
+"""Plots of the what-if studies."""
+
+from __future__ import annotations
+
+import pathlib
+from collections.abc import Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+from viz.sweep_plots import plot_summary  # noqa: E402
+
+
+def _save(fig, path: pathlib.Path) -> None:
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_lift(rows: Sequence[dict], path: pathlib.Path) -> None:
+    fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
+    p = [r["supply_kpa"] for r in rows]
+    ax.plot(p, [r["lift_closed_form_g"] for r in rows], "k-", label="torque balance with friction")
+    ax.plot(p, [r["lift_simulated_g"] for r in rows], "o", color="C3", label="simulation (bisection)")
+    ax.axhline(13.5, color="0.6", ls=":", label="13.5 g (thesis payload)")
+    ax.set_xlabel("supply pressure (kPa)")
+    ax.set_ylabel("heaviest tip payload lifted vertically (g)")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    _save(fig, path)
+
+
+def plot_pwm(rows: Sequence[dict], path: pathlib.Path) -> None:
+    fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
+    lines: dict[tuple, list[dict]] = {}
+    for r in rows:
+        lines.setdefault((r["controller"], r["trajectory"]), []).append(r)
+    for (controller, trajectory), members in sorted(lines.items()):
+        members.sort(key=lambda r: r["pwm_period_ms"])
+        ax.errorbar([r["pwm_period_ms"] for r in members], [r["rmse_mean_deg"] for r in members],
+                    yerr=[r["rmse_std_deg"] for r in members], marker="o", capsize=3,
+                    label=f"{controller} T{trajectory}")
+    ax.axvline(16, color="0.6", ls=":", label="thesis: 16 ms")
+    ax.set_xlabel("PWM period (ms)")
+    ax.set_ylabel("RMSE (deg)")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    _save(fig, path)
+
+
+def plot_gear_load(rows: Sequence[dict], path: pathlib.Path) -> None:
+    fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
+    x = range(len(rows))
+    ax.plot(x, [r["spur_peak_n"] for r in rows], "v", color="C3", label="spur: peak over one tick")
+    ax.plot(x, [r["spur_peak_10ms_n"] for r in rows], "o", color="C0", label="spur: peak over 10 ms")
+    ax.plot(x, [r["spur_lewis_at_peak_n"] for r in rows], "_", color="k", ms=12, label="Lewis safe load at that speed")
+    ax.set_xticks(list(x), [f"{r['controller']} T{r['trajectory']} {r['payload_g']:g}g {r['supply_kpa']:g}kPa"
+                            for r in rows], rotation=80, fontsize=6)
+    ax.set_ylabel("tooth force (N)")
+    ax.set_yscale("log")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    _save(fig, path)
+
+
+PLOTS = {"payload": plot_summary, "lift": plot_lift, "pwm": plot_pwm, "gear-load": plot_gear_load}
