@@ -33,7 +33,7 @@ def _mean_rmse_deg(controller: str, trajectory: int) -> float:
     return float(np.mean([math.degrees(r.metrics.rmse) for r in _results(controller)[trajectory]]))
 
 
-T2_GAP = ("Known gap: the twin tracks the T2 ramp better than the thesis's simulation (0.47 vs 0.83 deg). "
+T2_GAP = ("Known gap: the twin tracks the T2 ramp better than the thesis's simulation (0.46 vs 0.83 deg, 0.37 apart). "
           "The thesis does not describe its valve and delay implementation; the twin's averaged valve "
           "follows eq. 4.4.2 down to one PWM tick. See README, Reproduction.")
 
