@@ -13,7 +13,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 from viz.sweep_plots import plot_summary  # noqa: E402
 
 
-def _save(fig, path: pathlib.Path) -> None:
+def _finish(fig, ax, path: pathlib.Path, *, xlabel: str, ylabel: str) -> None:
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
@@ -24,11 +28,7 @@ def plot_lift(rows: Sequence[dict], path: pathlib.Path) -> None:
     ax.plot(p, [r["lift_closed_form_g"] for r in rows], "k-", label="torque balance with friction")
     ax.plot(p, [r["lift_simulated_g"] for r in rows], "o", color="C3", label="simulation (bisection)")
     ax.axhline(13.5, color="0.6", ls=":", label="13.5 g (thesis payload)")
-    ax.set_xlabel("supply pressure (kPa)")
-    ax.set_ylabel("heaviest tip payload lifted vertically (g)")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    _save(fig, path)
+    _finish(fig, ax, path, xlabel="supply pressure (kPa)", ylabel="heaviest tip payload lifted vertically (g)")
 
 
 def plot_pwm(rows: Sequence[dict], path: pathlib.Path) -> None:
@@ -42,11 +42,7 @@ def plot_pwm(rows: Sequence[dict], path: pathlib.Path) -> None:
                     yerr=[r["rmse_std_deg"] for r in members], marker="o", capsize=3,
                     label=f"{controller} T{trajectory}")
     ax.axvline(16, color="0.6", ls=":", label="thesis: 16 ms")
-    ax.set_xlabel("PWM period (ms)")
-    ax.set_ylabel("RMSE (deg)")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    _save(fig, path)
+    _finish(fig, ax, path, xlabel="PWM period (ms)", ylabel="RMSE (deg)")
 
 
 def plot_gear_load(rows: Sequence[dict], path: pathlib.Path) -> None:
@@ -57,11 +53,8 @@ def plot_gear_load(rows: Sequence[dict], path: pathlib.Path) -> None:
     ax.plot(x, [r["spur_lewis_at_peak_n"] for r in rows], "_", color="k", ms=12, label="Lewis safe load at that speed")
     ax.set_xticks(list(x), [f"{r['controller']} T{r['trajectory']} {r['payload_g']:g}g {r['supply_kpa']:g}kPa"
                             for r in rows], rotation=80, fontsize=6)
-    ax.set_ylabel("tooth force (N)")
     ax.set_yscale("log")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    _save(fig, path)
+    _finish(fig, ax, path, xlabel="run", ylabel="tooth force (N)")
 
 
 PLOTS = {"payload": plot_summary, "lift": plot_lift, "pwm": plot_pwm, "gear-load": plot_gear_load}
