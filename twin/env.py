@@ -34,12 +34,15 @@ from __future__ import annotations
 import collections
 import dataclasses
 import math
+import os
 
-import numpy as np
-from dm_control import mujoco as dm_mujoco
-from dm_control.rl import control
-from dm_control.suite import base
-from dm_env import specs
+os.environ.setdefault("MUJOCO_GL", "egl")  # dm_control picks a GL backend on import; the twin never renders here
+
+import numpy as np  # noqa: E402
+from dm_control import mujoco as dm_mujoco  # noqa: E402
+from dm_control.rl import control  # noqa: E402
+from dm_control.suite import base  # noqa: E402
+from dm_env import specs  # noqa: E402
 
 from twin.exceptions import InvalidScenario
 from twin.model import Orientation, build_mjcf, compile_joint
