@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+import pathlib
 
 import pytest
 
@@ -52,3 +53,22 @@ def deg(x: float) -> float:
 def frictionless() -> Plant:
     return custom_plant("frictionless", friction=FrictionParams(
         viscous=45.9, coulomb_poly=(0.0,), stiction=0.0))
+
+
+def listening_addresses(port: int) -> set[str]:
+    """Local addresses in LISTEN state on ``port``, read from /proc/net/tcp and tcp6."""
+    found = set()
+    for name in ("tcp", "tcp6"):
+        table = pathlib.Path("/proc/net") / name
+        if not table.exists():
+            continue
+        for line in table.read_text().splitlines()[1:]:
+            local, state = line.split()[1], line.split()[3]
+            address, hex_port = local.split(":")
+            if int(hex_port, 16) != port or state != "0A":
+                continue
+            if len(address) == 8:
+                found.add(".".join(str(b) for b in reversed(bytes.fromhex(address))))
+            else:
+                found.add(address)
+    return found

@@ -17,6 +17,12 @@ from twin.exceptions import InvalidScenario
 from twin.model import Orientation
 from twin.runner import run
 from twin.scenario import Scenario
+from twin.simulation import simulate
+
+OBSERVATION_SHAPES = {  # README "As a dm_control environment"
+    "rack_position": (1,), "angle": (1,), "velocity": (1,), "acceleration": (1,), "supply_pressure": (1,),
+    "chamber_pressures": (2,), "desired_angle": (joint_env.PREVIEW + 1,), "desired_velocity": (1,),
+    "desired_acceleration": (1,), "time_in_period": (1,), "time": (1,)}
 
 
 class TrackConformance(test_utils.EnvironmentTestMixin, unittest.TestCase):
@@ -68,12 +74,55 @@ def test_same_seed_same_episodes_and_episodes_differ():
         out = []
         for _ in range(2):
             timestep = environment.reset()
-            out.append((timestep.observation["desired_angle"][0], environment.physics.episode.scenario.payload))
+            out.append((timestep.observation["desired_angle"][0], environment.physics.episode.scenario.payload,
+                        timestep.observation["rack_position"][0]))
         return out
 
     assert first_observations(5) == first_observations(5)
     a, b = first_observations(5)
     assert a != b
+    other = first_observations(6)
+    for this, that in zip(first_observations(5), other, strict=True):
+        assert all(x != y for x, y in zip(this, that, strict=True))  # target, payload and noisy sample all differ
+
+
+class _Recorder:
+    """A controller that keeps the supply pressure it is shown at each update."""
+
+    def __init__(self, controller):
+        self.controller, self.period, self.seen = controller, controller.period, []
+
+    def reset(self, n):
+        self.controller.reset(n)
+
+    def update(self, t, measurement, setpoint):
+        self.seen.append(float(measurement.supply_pressure[0]))
+        return self.controller.update(t, measurement, setpoint)
+
+
+def test_environment_sees_the_pressure_noise_of_twin_run():
+    def recorder():
+        return _Recorder(make_controller("ffpva", nominal=NominalModel.thesis(), gain_set="simulation", tick=1e-3))
+
+    in_run = recorder()
+    simulate([Scenario("ffpva", 1, seed=4)], controllers=[in_run])
+    in_env = recorder()
+    environment = joint_env.load("track", trajectory=1, seed=4)
+    _episode(environment, ControllerPolicy(in_env, spur_radius=environment.physics.spur_radius))
+    assert len(in_env.seen) == len(in_run.seen) == 188  # ceil(3 s / 16 ms)
+    assert in_env.seen == in_run.seen
+    assert len(set(in_run.seen)) == len(in_run.seen)  # noisy, not the constant supply
+
+
+@pytest.mark.parametrize("name, action_period", [("smc", 16e-3), ("ffpva", 1e-3), ("ffpva", 32e-3)])
+def test_a_policy_at_another_period_than_the_environment_is_refused(name, action_period):
+    controller = make_controller(name, nominal=NominalModel.thesis(), gain_set="simulation", tick=1e-3)
+    environment = joint_env.load("track", trajectory=1, action_period=action_period, controller=name)
+    policy = ControllerPolicy(controller, spur_radius=environment.physics.spur_radius)
+    timestep = environment.reset()
+    with pytest.raises(InvalidScenario, match="action_period=controller.period"):
+        for _ in range(2):
+            timestep = environment.step(policy(timestep))
 
 
 def test_random_policy_raises_no_mujoco_warning():
@@ -89,18 +138,51 @@ def test_random_policy_raises_no_mujoco_warning():
         assert np.all(np.isfinite(environment.physics.true_angle))
 
 
-def test_observations_match_their_spec_and_episode_lengths():
+@pytest.mark.parametrize("task", joint_env.TASKS)
+def test_specs_before_the_first_reset_have_the_documented_shapes_and_bounds(task):
+    environment = joint_env.load(task, seed=0)
+    observation_spec, action_spec = environment.observation_spec(), environment.action_spec()
+    assert {name: spec.shape for name, spec in observation_spec.items()} == OBSERVATION_SHAPES
+    assert all(spec.dtype == np.float64 for spec in observation_spec.values())
+    assert (action_spec.shape, action_spec.dtype, float(action_spec.minimum), float(action_spec.maximum)) == \
+        ((1,), np.float64, -100.0, 100.0)
+    assert environment.control_timestep() == pytest.approx(16e-3)  # one PWM period
+    first = joint_env.load(task, seed=0).reset()  # reading the specs did not change the first episode
+    again = environment.reset()
+    for name in OBSERVATION_SHAPES:
+        np.testing.assert_array_equal(again.observation[name], first.observation[name])
+
+
+def test_observations_follow_their_spec_through_an_episode():
     environment = joint_env.load("track", trajectory=1, seed=0)
-    timestep = environment.reset()
     spec = environment.observation_spec()
-    assert set(timestep.observation) == set(spec)
-    assert timestep.observation["desired_angle"].shape == (joint_env.PREVIEW + 1,)
+    timestep = environment.reset()
     steps = 0
-    while not timestep.last():
+    while True:
+        for name, value in timestep.observation.items():
+            spec[name].validate(value)
+        assert timestep.observation["time"][0] == pytest.approx(steps * 16e-3)
+        assert timestep.observation["time_in_period"][0] == 0.0  # actions start PWM periods
+        if timestep.last():
+            break
         timestep = environment.step([0.0])
         steps += 1
     assert steps == 188  # ceil(3 s / 16 ms)
     assert timestep.step_type == dm_env.StepType.LAST
+
+
+@pytest.mark.parametrize("pwm_period, action_period", [(16e-3, 1e-3), (8e-3, None)])
+def test_preview_and_period_clock_follow_the_scenarios_pwm_period(pwm_period, action_period):
+    environment = joint_env.load("track", trajectory=1, seed=0, pwm_period=pwm_period, action_period=action_period)
+    assert environment.control_timestep() == pytest.approx(action_period or pwm_period)
+    timestep = environment.reset()
+    for _ in range(3):
+        timestep = environment.step([50.0])
+    physics, every = environment.physics, round(pwm_period / 1e-3)
+    k = physics.k
+    expected = physics.reference.position[k + every * np.arange(joint_env.PREVIEW + 1)] / physics.spur_radius
+    np.testing.assert_array_equal(timestep.observation["desired_angle"], expected)
+    assert timestep.observation["time_in_period"][0] == pytest.approx((k % every) * 1e-3)
 
 
 def test_bad_arguments_are_rejected():

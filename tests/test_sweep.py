@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import os
 import pathlib
+import re
 import signal
 import sqlite3
 import subprocess
@@ -13,9 +14,10 @@ import time
 
 import pytest
 
-from twin import grid
+from twin import cli, grid, sweep
 from twin.exceptions import InvalidScenario
-from twin.sweep import make_chunks, run_chunk, run_sweep
+from twin.store import COLUMNS, ResultStore, StaleStore
+from twin.sweep import WorkerLost, failed_record, make_chunks, run_chunk, run_sweep
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 AXES = {"controller": ["ffpva", "smc"], "trajectory": [1, 2], "payload": [0.0, 13.5],
@@ -49,10 +51,53 @@ def test_bad_axis_values_are_rejected_naming_the_value(name, value):
         grid.expand({name: grid.parse_axis(name, value)})
 
 
+@pytest.mark.parametrize("name, value", [("seed", "0,0"), ("payload", "0,0.0"), ("payload", "-0,0"),
+                                         ("controller", "smc,smc")])
+def test_repeated_values_give_one_scenario(name, value):
+    points = grid.expand({name: grid.parse_axis(name, value)})
+    assert len(points) == 1
+
+
+@pytest.mark.parametrize("name, value", [("trajectory", "1.5"), ("seed", "2.7"), ("seed", "0:4:1.5"),
+                                         ("trajectory", "1:2:0.5")])
+def test_fractional_trajectories_and_seeds_are_rejected_not_truncated(name, value):
+    with pytest.raises(InvalidScenario, match=re.escape(repr(value)) + ".*whole"):
+        grid.parse_axis(name, value)
+
+
+def test_whole_numbers_written_as_floats_are_accepted():
+    assert grid.parse_axis("trajectory", "2.0") == [2]
+    assert grid.parse_axis("seed", [1.0, 3]) == [1, 3]
+
+
+@pytest.mark.parametrize("plant_name", ["thesis", "thesis-pwm"])
+def test_the_plants_own_supply_and_pwm_period_are_the_same_scenario_as_leaving_them_out(plant_name):
+    implicit = grid.expand({"plant": [plant_name]})
+    explicit = grid.expand({"plant": [plant_name], "supply_kpa": grid.parse_axis("supply_kpa", "300"),
+                            "pwm_period_ms": grid.parse_axis("pwm_period_ms", "16")})
+    assert [p.key for p in explicit] == [p.key for p in implicit]
+    both = grid.expand({"plant": [plant_name], "supply_kpa": [None, 300.0, 400.0]})
+    assert [p.supply_kpa for p in both] == [None, 400.0]
+
+
+def test_a_bad_orientation_is_an_invalid_scenario_naming_it():
+    with pytest.raises(InvalidScenario, match="'sideways'"):
+        grid.expand({"orientation": grid.parse_axis("orientation", "horizontal,sideways")})
+
+
 def test_toml_grid(tmp_path):
     (tmp_path / "g.toml").write_text('[grid]\ncontroller = ["smc"]\npayload = "0:13.5:6.75"\nseed = "0-1"\n')
     axes = grid.read_toml(tmp_path / "g.toml")
     assert axes == {"controller": ["smc"], "payload": [0.0, 6.75, 13.5], "seed": [0, 1]}
+
+
+@pytest.mark.parametrize("config, bad", [(None, "missing.toml"), ('[grid]\nseed = [0, 1\n', "bad.toml"),
+                                         ('grid = 3\n', "bad.toml")])
+def test_an_unreadable_config_is_an_invalid_scenario_naming_the_file(tmp_path, config, bad):
+    if config is not None:
+        (tmp_path / bad).write_text(config)
+    with pytest.raises(InvalidScenario, match=re.escape(bad)):
+        grid.read_toml(tmp_path / bad)
 
 
 def test_chunking_and_workers_do_not_change_numbers(tmp_path):
@@ -77,6 +122,74 @@ def test_rerun_skips_what_is_done(tmp_path):
     assert (first.ran, first.skipped) == (2, 0)
     assert (again.ran, again.skipped) == (0, 2)
     assert first.records == again.records
+
+
+def _raise_on_seed(monkeypatch, seed: int, error: BaseException) -> None:
+    import twin.runner
+
+    real = twin.runner.run_many
+
+    def flaky(scenarios, **kwargs):
+        if any(s.seed == seed for s in scenarios):
+            raise error
+        return real(scenarios, **kwargs)
+
+    monkeypatch.setattr(twin.runner, "run_many", flaky)
+
+
+def test_rerun_retries_what_failed(tmp_path, monkeypatch):
+    points = grid.expand({"controller": ["ffpva"], "trajectory": [2], "seed": [0, 1, 2]})
+    with monkeypatch.context() as patch:
+        _raise_on_seed(patch, 1, RuntimeError("transient"))
+        first = run_sweep(points, out=tmp_path, workers=1)
+    assert [r["status"] for r in first.records] == ["ok", "failed", "ok"]
+    again = run_sweep(points, out=tmp_path, workers=1)
+    assert (again.ran, again.skipped) == (1, 2)
+    assert [r["status"] for r in again.records] == ["ok", "ok", "ok"]
+    assert again.records[0] == first.records[0] and again.records[2] == first.records[2]
+
+
+def test_a_store_of_another_code_version_is_refused(tmp_path, monkeypatch):
+    points = grid.expand({"controller": ["ffpva"], "trajectory": [2], "seed": [0]})
+    run_sweep(points, out=tmp_path, workers=1)
+    monkeypatch.setattr(sweep, "code_version", lambda: "store 2, twin 9.9, params 0")
+    with pytest.raises(StaleStore, match="new --out folder"):
+        run_sweep(points, out=tmp_path, workers=1)
+
+
+def test_a_store_without_a_version_but_with_results_is_refused(tmp_path):
+    path = tmp_path / "results.sqlite"
+    store = ResultStore(path, version="a")
+    point = grid.expand({})[0]
+    store.add([failed_record(point, RuntimeError("x"))])
+    store.close()
+    with sqlite3.connect(path) as db:
+        db.execute("DELETE FROM meta")
+    db.close()
+    with pytest.raises(StaleStore, match="did not record its version"):
+        ResultStore(path, version="a")
+    ResultStore(tmp_path / "empty.sqlite", version="b").close()
+    ResultStore(tmp_path / "empty.sqlite", version="b").close()  # same version: resumable
+
+
+def test_a_killed_worker_is_one_clear_error_and_keeps_what_finished(tmp_path, monkeypatch):
+    import twin.runner
+
+    parent = os.getpid()
+    real = twin.runner.run_many
+
+    def dies_in_worker(scenarios, **kwargs):
+        if os.getpid() != parent and any(s.seed == 1 for s in scenarios):
+            os.kill(os.getpid(), signal.SIGKILL)
+        return real(scenarios, **kwargs)
+
+    monkeypatch.setattr(twin.runner, "run_many", dies_in_worker)
+    points = grid.expand({"controller": ["ffpva"], "trajectory": [2], "seed": [0, 1]})
+    with pytest.raises(WorkerLost, match="finished scenarios are kept.*run the same command again") as caught:
+        run_sweep(points, out=tmp_path, workers=2)
+    assert "\n" not in str(caught.value)
+    monkeypatch.setattr(twin.runner, "run_many", real)
+    assert all(r["status"] == "ok" for r in run_sweep(points, out=tmp_path, workers=2).records)
 
 
 def test_a_scenario_that_raises_is_marked_failed_with_its_reason(monkeypatch):
@@ -127,6 +240,55 @@ def test_sigkill_midway_then_rerun_gives_every_scenario_once_and_the_same_number
     assert rows == _rows(tmp_path / "ref" / "results.csv")
 
 
+class _FakeRay:
+    """Just enough of ``ray`` to see how a sweep sizes and submits its chunks."""
+
+    def __init__(self, cpus: int):
+        self.cpus, self.init_kwargs, self.submitted = cpus, None, []
+
+    def is_initialized(self):
+        return False
+
+    def init(self, **kwargs):
+        self.init_kwargs = kwargs
+
+    def cluster_resources(self):
+        return {"CPU": float(self.cpus)}
+
+    def remote(self, function):
+        fake = self
+
+        class Remote:
+            def remote(self, chunk):
+                fake.submitted.append(chunk)
+                return function(chunk)
+
+        return Remote()
+
+    def wait(self, pending, num_returns):
+        return pending[:num_returns], pending[num_returns:]
+
+    def get(self, ref):
+        return ref
+
+    def cancel(self, ref):
+        pass
+
+    def shutdown(self):
+        pass
+
+
+@pytest.mark.parametrize("workers, cpus", [(None, 3), (1, 3), (None, 16)])
+def test_ray_chunks_follow_the_cluster_cpus_or_workers(tmp_path, monkeypatch, workers, cpus):
+    fake = _FakeRay(cpus)
+    monkeypatch.setitem(sys.modules, "ray", fake)
+    monkeypatch.setattr(sweep, "run_chunk", lambda chunk: [failed_record(p, RuntimeError("not run")) for p in chunk])
+    points = grid.expand({"controller": ["pva", "ffpva", "smc"], "trajectory": [2], "seed": list(range(8))})
+    run_sweep(points, out=tmp_path, backend="ray", workers=workers)
+    assert fake.submitted == make_chunks(points, workers or cpus)
+    assert fake.init_kwargs["log_to_driver"] is False
+
+
 def test_ray_backend_gives_the_same_numbers_as_local(tmp_path):
     ray = pytest.importorskip("ray")
     points = grid.expand({"controller": ["ffpva", "smc"], "trajectory": [2], "seed": [0, 1]})
@@ -149,6 +311,72 @@ def test_cli_writes_tables_and_plot(tmp_path):
     summary = _rows(tmp_path / "s" / "summary.csv")
     assert [float(s["payload_g"]) for s in summary] == [0.0, 13.5]
     assert all(s["runs"] == "2" for s in summary)
+    with open(tmp_path / "s" / "results.csv") as handle:
+        assert next(csv.reader(handle)) == list(COLUMNS)
+
+
+def _group(**fields) -> dict:
+    row = {"controller": "ffpva", "trajectory": 1, "payload_g": 0.0, "orientation": "horizontal", "plant": "thesis",
+           "supply_kpa": None, "pwm_period_ms": None, **fields}
+    return {**row, "rmse_mean_deg": 1.0, "rmse_std_deg": 0.1, "rmse_min_deg": 0.9, "rmse_max_deg": 1.1}
+
+
+def _axes_drawn(summary):
+    import matplotlib.pyplot as plt
+
+    from viz.sweep_plots import draw_summary
+
+    fig, ax = plt.subplots()
+    draw_summary(ax, summary)
+    plt.close(fig)
+    return ax
+
+
+def test_plot_draws_one_labelled_line_per_supply_and_pwm_group():
+    summary = [_group(payload_g=m, supply_kpa=kpa, pwm_period_ms=ms)
+               for kpa in (None, 400.0) for ms in (None, 8.0) for m in (0.0, 13.5)]
+    handles, labels = _axes_drawn(summary).get_legend_handles_labels()
+    assert len(handles) == 4 and len(set(labels)) == 4
+    assert {"ffpva T1 300 kPa PWM 16 ms", "ffpva T1 400 kPa PWM 8 ms"} <= set(labels)
+
+
+def test_plot_labels_every_bar_by_what_varies():
+    summary = [_group(plant=name, orientation=o) for name in ("thesis", "thesis-pwm") for o in ("horizontal", "vertical")]
+    labels = [t.get_text() for t in _axes_drawn(summary).get_xticklabels()]
+    assert len(labels) == 4 and len(set(labels)) == 4
+    assert "ffpva T1 vertical thesis-pwm" in labels
+
+
+def test_readme_lists_the_columns_of_results_csv():
+    readme = (ROOT / "README.md").read_text()
+    listed = re.search(r"one row per scenario with the\s+columns `([^`]+)`", readme)
+    assert listed is not None
+    assert [c.strip() for c in listed.group(1).split(",")] == list(COLUMNS)
+
+
+@pytest.mark.parametrize("args, bad", [
+    (["--orientation", "sideways"], "sideways"),
+    (["--trajectory", "1.5"], "1.5"),
+    (["--seed", "2.7"], "2.7"),
+    (["--config", "missing.toml"], "missing.toml"),
+    (["--config", "broken.toml"], "broken.toml"),
+])
+def test_cli_bad_sweep_input_is_one_line_and_exit_2(tmp_path, monkeypatch, capsys, args, bad):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "broken.toml").write_text("[grid\nseed = 1\n")
+    assert cli.main(["sweep", *args, "--out", "x"]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("twin: error:") and bad in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "x").exists()
+
+
+def test_cli_refuses_a_store_of_another_version_in_one_line(tmp_path, monkeypatch, capsys):
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "x").mkdir()
+    ResultStore(tmp_path / "x" / "results.sqlite", version="an old one").close()
+    assert cli.main(["sweep", "--trajectory", "2", "--out", "x"]) == 2
+    err = capsys.readouterr().err
+    assert "new --out folder" in err and len(err.strip().splitlines()) == 1
 
 
 def test_cli_rejects_a_bad_axis_with_one_line(tmp_path):

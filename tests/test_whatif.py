@@ -1,7 +1,9 @@
-"""What-if studies against closed forms (Lewis loads, static lift limit, tooth force when holding)."""
+"""What-if studies against closed forms (Lewis loads, static lift limit, tooth force when holding), the
+PWM study's controller rates, the gear-load windows and the CLI."""
 
 from __future__ import annotations
 
+import csv
 import math
 import os
 import pathlib
@@ -11,11 +13,13 @@ import sys
 import numpy as np
 import pytest
 
+import controllers
 from tests.conftest import open_loop
+from twin.cli import main
 from twin.gears import lewis_safe_load
 from twin.model import Orientation
 from twin.params import GearParams, JointParams
-from twin.whatif import lift_study
+from twin.whatif import lift_study, mesh_loads, pwm_study
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 COULOMB = (-3.051e14, 1.587e13, -3.244e11, 3.294e9, -1.727e7, 4.36e4, -39.551)  # eq. 4.5.7
@@ -39,11 +43,16 @@ def _lift_by_hand(pressure: float) -> float:
 
 
 def test_static_lift_limit_matches_the_torque_balance():
-    study = lift_study(pressures_kpa=[250.0, 500.0], tolerance=0.004)
+    study = lift_study(pressures_kpa=[500.0, 250.0], tolerance=0.004)  # unsorted on purpose
+    assert [row["supply_kpa"] for row in study.rows] == [250.0, 500.0]
     for row in study.rows:
         by_hand = _lift_by_hand(row["supply_kpa"] * 1e3) * 1e3
         assert row["lift_closed_form_g"] == pytest.approx(by_hand, rel=1e-3)
         assert row["lift_simulated_g"] == pytest.approx(by_hand, rel=0.02)
+    low, high = (row["lift_simulated_g"] for row in study.rows)
+    at_300 = low + (high - low) * (300.0 - 250.0) / (500.0 - 250.0)
+    assert f"about {at_300:.1f} g can be lifted at the tip at 300 kPa (interpolated between 250 and 500 kPa)" \
+        in study.answer
 
 
 def test_too_low_a_pressure_lifts_nothing():
@@ -59,6 +68,40 @@ def test_spur_tooth_force_when_holding_is_the_gravity_torque_over_r_spur():
     assert result.trace.tooth_force_spur[-1] == pytest.approx(torque / p.gears.spur_radius, rel=1e-6)
 
 
+def test_gear_load_compares_each_window_with_the_lewis_load_at_its_own_worst_tick():
+    force = np.zeros(40)
+    force[10], force[30] = 10.0, 5.0  # N: the bigger impact where the gear may carry more
+    allowed = np.full(40, 20.0)
+    allowed[30] = 4.0  # N
+    loads = mesh_loads("spur", force, allowed, 1e-3)
+    assert loads["spur_peak_1ms_n"] == 10.0
+    assert (loads["spur_at_worst_1ms_n"], loads["spur_lewis_at_worst_1ms_n"]) == (5.0, 4.0)
+    assert loads["spur_worst_ratio_1ms"] == pytest.approx(1.25)
+    assert loads["spur_peak_10ms_n"] == pytest.approx(1.0)  # one tick of 10 N over 10 ms
+    assert (loads["spur_at_worst_10ms_n"], loads["spur_lewis_at_worst_10ms_n"]) == (pytest.approx(0.5), 4.0)
+    assert loads["spur_worst_ratio_10ms"] == pytest.approx(0.125)  # averaged, nothing exceeds
+    assert [loads[f"spur_peak_{w}ms_n"] for w in (1, 2, 5, 10, 20)] == \
+        pytest.approx([10.0, 5.0, 2.0, 1.0, 0.5])
+
+
+def test_pwm_study_varies_the_valves_only(monkeypatch):
+    original, built = controllers.make_controller, []
+
+    def spy(*args, **kwargs):
+        built.append(original(*args, **kwargs))
+        return built[-1]
+
+    monkeypatch.setattr(controllers, "make_controller", spy)
+    study = pwm_study(periods_ms=[8.0, 32.0], trajectories=(1,), seeds=1)
+    periods = {type(c).__name__: (c.period, getattr(c, "slow_period", c.period)) for c in built}
+    assert periods == {"FeedForwardPVA": (16e-3, 16e-3), "SlidingMode": (1e-3, 16e-3)}  # the thesis's rates
+    assert sorted((r["controller"], r["pwm_period_ms"], r["plant"]) for r in study.rows) == [
+        ("ffpva", 8.0, "thesis-pwm"), ("ffpva", 32.0, "thesis-pwm"), ("smc", 8.0, "thesis-pwm"),
+        ("smc", 32.0, "thesis-pwm")]
+    assert all(r["failed"] == 0 and math.isfinite(r["rmse_mean_deg"]) for r in study.rows)
+    assert "Only the valves' PWM period varies" in study.answer
+
+
 def test_whatif_cli_writes_table_plot_and_answer(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.run([sys.executable, "-m", "twin", "whatif", "gear-load", "--out", "w"], cwd=tmp_path,
@@ -66,4 +109,31 @@ def test_whatif_cli_writes_table_plot_and_answer(tmp_path):
     assert proc.returncode == 0, proc.stderr
     for suffix in (".csv", ".png", ".txt"):
         assert (tmp_path / "w" / f"gear-load{suffix}").stat().st_size > 0
-    assert "Lewis" in proc.stdout
+    assert "Lewis" in proc.stdout and "by averaging window: 1 ms" in proc.stdout
+    with open(tmp_path / "w" / "gear-load.csv") as handle:
+        header = next(csv.reader(handle))
+    assert {"spur_peak_1ms_n", "spur_peak_10ms_n", "pinion_lewis_at_worst_10ms_n"} <= set(header)
+
+
+def test_whatif_lift_cli_writes_sorted_rows_and_says_what_it_did_not_study(tmp_path, capsys):
+    out = tmp_path / "lift"
+    assert main(["whatif", "lift", "--pressures", "150,100", "--out", str(out)]) == 0
+    for suffix in (".csv", ".png", ".txt"):
+        assert (out / f"lift{suffix}").stat().st_size > 0
+    with open(out / "lift.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert [float(r["supply_kpa"]) for r in rows] == [100.0, 150.0]
+    assert all(float(r["lift_simulated_g"]) == 0.0 for r in rows)  # neither lifts the bare link
+    answer = (out / "lift.txt").read_text()
+    assert "300 kPa was not studied (pressures 100-150 kPa)" in answer
+    assert answer.strip() in capsys.readouterr().out
+
+
+@pytest.mark.parametrize("study, flag, value", [
+    ("lift", "--pressures", "100,x"), ("lift", "--pressures", "900"), ("payload", "--payloads", "0,x"),
+    ("payload", "--payloads", "-5"), ("pwm", "--periods", "2.5")])
+def test_whatif_rejects_a_bad_list_naming_its_flag_and_writes_nothing(tmp_path, capsys, study, flag, value):
+    out = tmp_path / "never"
+    assert main(["whatif", study, flag, value, "--out", str(out)]) == 2
+    assert flag in capsys.readouterr().err
+    assert not out.exists()

@@ -3,6 +3,7 @@
     twin demo                      reproduce the thesis's controller comparison
     twin run --controller ffpva --trajectory 1 --json      one scenario
     twin bench                     cost per simulated second
+    twin view --controller smc --trajectory 4              the joint live in a browser
 
 Degrees, grams and kPa here; SI inside. Bad input gets a one-line error and
 exit code 2, and nothing is written.
@@ -16,6 +17,7 @@ import math
 import os
 import pathlib
 import sys
+import time
 
 from twin.exceptions import TwinError
 from twin.model import Orientation
@@ -65,6 +67,9 @@ _grams = _checked(float, lambda v: v >= 0, "payload must be a non-negative numbe
 _kpa = _checked(float, lambda v: 0 < v <= 700, "supply pressure must be in (0, 700] kPa (cylinder rating)")
 _seed = _checked(int, lambda v: v >= 0, "seed must be a non-negative integer")
 _positive_int = _checked(int, lambda v: v >= 1, "expected a positive integer")
+_port = _checked(int, lambda v: 0 <= v <= 65535, "port must be an integer in [0, 65535]")
+_speed = _checked(float, lambda v: 0 < v <= 10, "speed must be in (0, 10] times real time")
+_seconds = _checked(float, lambda v: v > 0, "duration must be a positive number of seconds")
 
 
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
@@ -99,6 +104,10 @@ def _cmd_run(args: argparse.Namespace) -> int:
         from viz.plots import plot_run
 
         plot_run(result, args.plot)
+    if args.html:
+        from viz.recording import write_recording
+
+        write_recording(result, args.html)
     record = report.summary(result)
     if args.json:
         print(json.dumps(record))
@@ -108,6 +117,28 @@ def _cmd_run(args: argparse.Namespace) -> int:
         for warning in record["warnings"]:
             print(f"warning: {warning}")
     return 1 if result.warnings else 0
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    from viz.live_server import LiveSession, LiveViewer
+
+    session = LiveSession(scenario_from(args), record=args.html is not None)
+    viewer = LiveViewer(session, host=args.host, port=args.port, speed=args.speed)
+    if args.host not in ("127.0.0.1", "localhost", "::1"):
+        print(f"warning: serving on {args.host}: anyone who can reach it can drive the twin", file=sys.stderr)
+    print(f"twin view: open {viewer.url}  (Ctrl-C to stop)", flush=True)
+    if args.duration is not None:
+        stop_at = time.monotonic() + args.duration
+        viewer.on_frame = lambda: viewer.stop() if time.monotonic() >= stop_at else None
+    try:
+        viewer.start()
+    except KeyboardInterrupt:
+        viewer.stop()
+    print("twin view: stopped", flush=True)
+    if args.html is not None:
+        session.write_html(args.html)
+        print(f"wrote {args.html}", flush=True)
+    return 0
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
@@ -137,7 +168,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
     from twin import grid, tables
-    from twin.sweep import run_sweep
+    from twin.sweep import open_store, run_sweep
 
     axes = grid.read_toml(args.config) if args.config else {}
     for name in grid.AXES:
@@ -146,6 +177,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
             axes[name] = grid.parse_axis(name, value)
     points = grid.expand(axes)
     args.out.mkdir(exist_ok=True)
+    open_store(args.out).close()  # refuses a store of another code version before any output
     print(f"{len(points)} scenarios -> {args.out.resolve()}", file=sys.stderr)
     bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
     try:
@@ -173,32 +205,51 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     return 1 if failed else 0
 
 
+_WHATIF_LISTS = {"payload": ("--payloads", "payloads", "payload"), "lift": ("--pressures", "pressures", "supply_kpa"),
+                 "pwm": ("--periods", "periods", "pwm_period_ms")}  # study: (flag, attribute, sweep axis)
+
+
+def _whatif_values(args: argparse.Namespace, plant_name: str) -> list | None:
+    """The study's list flag, parsed and every scenario it implies built (so bad input fails before
+    anything is written), in edge units; errors name the flag. None for a study without a list."""
+    from twin import grid
+    from twin.exceptions import InvalidScenario
+
+    if args.study not in _WHATIF_LISTS:
+        return None
+    flag, attribute, axis = _WHATIF_LISTS[args.study]
+    try:
+        values = grid.parse_axis(axis, getattr(args, attribute))
+        grid.expand({axis: values, "plant": [plant_name]})
+    except InvalidScenario as error:
+        message = str(error).replace(f"--{axis.replace('_', '-')}", flag)  # grid names its own flag (--payload)
+        raise InvalidScenario(message if flag in message else f"{flag}: {message}") from None
+    return values
+
+
 def _cmd_whatif(args: argparse.Namespace) -> int:
     import csv
 
     from tqdm import tqdm
 
-    from twin import grid, whatif
+    from twin import whatif
     from viz.whatif_plots import PLOTS
 
+    plant_name = args.plant or whatif.DEFAULT_PLANTS[args.study]
+    values = _whatif_values(args, plant_name)
     args.out.mkdir(exist_ok=True)
-    store = args.out / f"{args.study}-runs"
-    if args.study in ("payload", "pwm"):
-        store.mkdir(exist_ok=True)
     with tqdm(unit="scenario", file=sys.stderr, dynamic_ncols=True, desc=args.study) as bar:
         if args.study == "payload":
-            study = whatif.payload_study(out=store, payloads_g=grid.parse_axis("payload", args.payloads),
-                                         trajectory=args.trajectory, seeds=args.seeds, plant_name=args.plant,
-                                         workers=args.workers, progress=bar.update)
+            store = args.out / "payload-runs"
+            store.mkdir(exist_ok=True)
+            study = whatif.payload_study(out=store, payloads_g=values, trajectory=args.trajectory, seeds=args.seeds,
+                                         plant_name=plant_name, workers=args.workers, progress=bar.update)
         elif args.study == "pwm":
-            study = whatif.pwm_study(out=store, periods_ms=grid.parse_axis("pwm_period_ms", args.periods),
-                                     seeds=args.seeds, plant_name=args.plant, workers=args.workers,
-                                     progress=bar.update)
+            study = whatif.pwm_study(periods_ms=values, seeds=args.seeds, plant_name=plant_name)
         elif args.study == "lift":
-            study = whatif.lift_study(pressures_kpa=grid.parse_axis("supply_kpa", args.pressures),
-                                      plant_name=args.plant)
+            study = whatif.lift_study(pressures_kpa=values, plant_name=plant_name)
         else:
-            study = whatif.gear_load_study(plant_name=args.plant)
+            study = whatif.gear_load_study(plant_name=plant_name)
     stem = args.out / args.study
     with open(stem.with_suffix(".csv"), "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=list(study.rows[0]))
@@ -233,7 +284,8 @@ def build_parser() -> argparse.ArgumentParser:
                            help="comma list; numbers also start:stop:step; seeds also a-b")
     sweep.add_argument("--config", type=pathlib.Path, metavar="GRID.toml", help="axes from a TOML file")
     sweep.add_argument("--out", type=_out_dir, required=True, metavar="DIR", help="results folder (created)")
-    sweep.add_argument("--workers", type=_positive_int, default=None, help="processes (default: all cores)")
+    sweep.add_argument("--workers", type=_positive_int, default=None,
+                       help="processes (default: all cores); with Ray, CPUs to size chunks for (default: the cluster's)")
     sweep.add_argument("--backend", choices=("local", "ray"), default="local")
     sweep.add_argument("--ray-address", default=None, help="Ray cluster address (default: RAY_ADDRESS or local)")
     sweep.set_defaults(func=_cmd_sweep)
@@ -241,11 +293,12 @@ def build_parser() -> argparse.ArgumentParser:
     whatif = sub.add_parser("whatif", help="payload, lift, PWM and gear-load studies")
     whatif.add_argument("study", choices=("payload", "lift", "pwm", "gear-load"))
     whatif.add_argument("--out", type=_out_dir, required=True, metavar="DIR")
-    whatif.add_argument("--plant", choices=sorted(PLANTS), default="thesis")
+    whatif.add_argument("--plant", choices=sorted(PLANTS), default=None,
+                        help="default: thesis-pwm for pwm (switching valves), thesis otherwise")
     whatif.add_argument("--payloads", default="0:30:2.5", metavar="LIST", help="grams (payload study)")
     whatif.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), default=1, help="payload study")
     whatif.add_argument("--pressures", default="100:700:50", metavar="LIST", help="kPa (lift study)")
-    whatif.add_argument("--periods", default="8:32:4", metavar="LIST", help="PWM periods in ms (pwm study)")
+    whatif.add_argument("--periods", default="8:32:4", metavar="LIST", help="valve PWM periods in ms (pwm study)")
     whatif.add_argument("--seeds", type=_positive_int, default=3)
     whatif.add_argument("--workers", type=_positive_int, default=None)
     whatif.set_defaults(func=_cmd_whatif)
@@ -255,7 +308,20 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--trace", type=_writable_file(".csv"), metavar="FILE.csv", help="write the time series")
     run.add_argument("--plot", type=_writable_file(".png"), metavar="FILE.png", help="write a figure")
     run.add_argument("--json", action="store_true", help="print exactly one JSON object")
+    run.add_argument("--html", type=_writable_file(".html"), metavar="FILE.html",
+                     help="write a self-contained 3D recording with its traces")
     run.set_defaults(func=_cmd_run)
+
+    view = sub.add_parser("view", help="the joint live in a browser (3D view and control panel)")
+    add_scenario_arguments(view)
+    view.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1 only)")
+    view.add_argument("--port", type=_port, default=7000, help="TCP port (default 7000; 0: any free port)")
+    view.add_argument("--speed", type=_speed, default=1.0, help="simulated seconds per second (default 1)")
+    view.add_argument("--duration", type=_seconds, default=None, metavar="SECONDS",
+                      help="stop after this many seconds of wall time (default: run until Ctrl-C)")
+    view.add_argument("--html", type=_writable_file(".html"), metavar="FILE.html",
+                      help="on stopping, write a recording of the last model's run (up to 10 min)")
+    view.set_defaults(func=_cmd_view)
     return parser
 
 

@@ -18,15 +18,20 @@ Tasks
     payload (0 - 13.5 g) and orientation (unless given), for 2 s.
 Reward per step: exp(-e^2 / 2) with e the true tracking error in degrees at
 the end of the step (1 on target, 0.61 at 1 deg, 0.01 at 3 deg).
-Action: duty in [-100, 100] %, held for one PWM period (16 ms), or for 1 ms
-with ``action_period=1e-3``.
+Action: duty in [-100, 100] %, held for one action period: by default the
+scenario's PWM period (16 ms unless ``pwm_period`` is given), or e.g. 1 ms with
+``action_period=1e-3``.
 Observations: measured rack position and angle, observer velocity and
 acceleration, measured supply and chamber pressures, the desired angle now and
-at the next ``PREVIEW`` PWM periods, the desired rack velocity and acceleration
-now, and the time within the PWM period.
+at the next ``PREVIEW`` PWM periods (the scenario's period), the desired rack
+velocity and acceleration now, the time within the PWM period and the time
+since the episode began.
 Randomness: the task's random state (seeded by ``seed``) draws each episode's
 targets, payloads and sensor-noise seeds; the first episode uses ``seed``
-itself for the sensor noise, so it matches ``twin run --seed``.
+itself for the sensor noise (position and pressures), so at every tick it
+shares with ``twin run --seed`` it sees the same noise.
+Before the first ``reset()`` the physics holds a default episode (no random
+draws), so the specs exist at once, as in dm_control's suite.
 """
 
 from __future__ import annotations
@@ -53,7 +58,6 @@ from twin.trajectories import Reference, Segment, Trajectory, trajectory
 
 TASKS = ("track", "hold")
 PREVIEW = 5  # future desired-angle samples, one PWM period apart
-PWM_PERIOD = 16e-3  # s
 HOLD_DURATION = 2.0  # s
 RANDOM_TRACK_DURATION = 4.0  # s
 RANDOM_RANGE = (math.radians(30.0), math.radians(160.0))  # rad, inside the friction fit
@@ -84,7 +88,8 @@ class JointPhysics(dm_mujoco.Physics):
         self.episode, self.ticks = episode, ticks
         r_s = preset.params.gears.spur_radius
         self.spur_radius = r_s
-        times = np.arange(ticks + PREVIEW * whole_ticks(PWM_PERIOD, preset.timestep) + 1) * preset.timestep
+        self.pwm_ticks = whole_ticks(preset.params.valves.pwm_period, preset.timestep, what="PWM period")
+        times = np.arange(ticks + PREVIEW * self.pwm_ticks + 1) * preset.timestep
         self.reference: Reference = episode.trajectory.sample(times, r_s)
         y0 = np.array([episode.initial_angle * r_s])
         place_on_manifold(self.data.qpos[None, :], self.joint, y0)
@@ -159,6 +164,16 @@ class JointTask(base.Task):
             segments.append(Segment("rest", RANDOM_TRACK_DURATION - elapsed))
         return Trajectory(0, start, tuple(segments))
 
+    def default_episode(self) -> Episode:
+        """What the physics holds before the first reset: drawn from nothing random, so building
+        it does not change the episodes that ``reset()`` gives."""
+        if self.name == "track" and self.trajectory_number is not None:
+            r_s = self.base_scenario.preset.params.gears.spur_radius
+            reference = trajectory(self.trajectory_number, spur_radius=r_s)
+        else:
+            reference = Trajectory(0, sum(RANDOM_RANGE) / 2, (Segment("rest", self.duration),))
+        return Episode(self.base_scenario, reference, reference.start)
+
     def next_episode(self) -> Episode:
         seed = self._first_seed if self._episodes == 0 else int(self.random.randint(2**31 - 1))
         self._episodes += 1
@@ -199,7 +214,7 @@ class JointTask(base.Task):
     def get_observation(self, physics: JointPhysics) -> collections.OrderedDict:
         m = physics.measurement
         pa, pb = physics.plant.measured_pressures(min(physics.k, physics.ticks))
-        every = whole_ticks(PWM_PERIOD, physics.timestep())
+        every = physics.pwm_ticks
         k = physics.k
         preview = [physics.desired_angle(k + i * every) for i in range(PREVIEW + 1)]
         obs = collections.OrderedDict()
@@ -213,6 +228,7 @@ class JointTask(base.Task):
         obs["desired_velocity"] = physics.reference.velocity[k:k + 1].copy()
         obs["desired_acceleration"] = physics.reference.acceleration[k:k + 1].copy()
         obs["time_in_period"] = np.array([(k % every) * physics.timestep()])
+        obs["time"] = np.array([k * physics.timestep()])
         return obs
 
     def get_reward(self, physics: JointPhysics) -> float:
@@ -224,12 +240,13 @@ def episode_steps(duration: float, action_period: float) -> int:
     return math.ceil(round(duration / action_period, 9))
 
 
-def load(task: str = "track", *, trajectory: int | None = 1, action_period: float = PWM_PERIOD,
+def load(task: str = "track", *, trajectory: int | None = 1, action_period: float | None = None,
          seed: int = 0, controller: str = "ffpva", **scenario) -> control.Environment:
     """A dm_control Environment of the joint.
 
     ``scenario`` takes the keyword arguments of :class:`twin.scenario.Scenario`
-    (``payload`` in kg, ``orientation``, ``plant``, ``noise``, ``supply_pressure``).
+    (``payload`` in kg, ``orientation``, ``plant``, ``noise``, ``supply_pressure``,
+    ``pwm_period`` in s). ``action_period`` (s) defaults to the scenario's PWM period.
     ``hold`` randomises payload and orientation unless either is given.
     """
     if task not in TASKS:
@@ -238,6 +255,8 @@ def load(task: str = "track", *, trajectory: int | None = 1, action_period: floa
         raise InvalidScenario(f"unknown trajectory {trajectory!r}: choose 1-4 or None (random)")
     randomise_load = task == "hold" and "payload" not in scenario and "orientation" not in scenario
     base_scenario = Scenario(controller, trajectory or 1, seed=seed, **scenario)
+    if action_period is None:
+        action_period = base_scenario.preset.params.valves.pwm_period
     root = build_mjcf(params=base_scenario.preset.params, payload_mass=base_scenario.payload,
                       orientation=base_scenario.orientation, timestep=base_scenario.preset.timestep)
     physics = JointPhysics.from_xml_string(root.to_xml_string(), root.get_assets())
@@ -245,6 +264,7 @@ def load(task: str = "track", *, trajectory: int | None = 1, action_period: floa
     whole_ticks(action_period, physics.timestep(), what="action period")
     joint_task = JointTask(name=task, trajectory_number=trajectory if task == "track" else None,
                            scenario=base_scenario, randomise_load=randomise_load, seed=seed)
+    physics.begin(joint_task.default_episode(), ticks=physics.ticks_for(joint_task.duration))
     steps = episode_steps(joint_task.duration, action_period)
     # dm_control ends an episode once step_count >= time_limit / control_timestep.
     return control.Environment(physics, joint_task, time_limit=(steps - 0.5) * action_period,

@@ -47,8 +47,8 @@ def place_on_manifold(qpos: np.ndarray, joint: JointModel, y: np.ndarray) -> Non
 class PlantState:
     """Noise, sensors, observer, valves and hydraulics for ``scenarios``.
 
-    ``lengths[i]`` is scenario i's number of ticks (its noise is drawn for
-    exactly that many, so a scenario's noise does not depend on its batch);
+    ``lengths[i]`` is scenario i's number of ticks; its noise at tick k depends
+    only on its seed and k, not on its batch or its length;
     ``initial_position`` (n,) is where each rack starts at rest (m).
     """
 
@@ -66,8 +66,12 @@ class PlantState:
         for i, (s, p, length) in enumerate(zip(scenarios, self.plants, lengths, strict=True)):
             if s.noise:
                 rng = np.random.default_rng(s.seed)
+                # Pressure noise has its own stream (spawned, not drawn after the positions), so a loop that
+                # runs longer (the environment's episodes) sees the same noise at every tick as ``twin run``.
+                (pressure_rng,) = rng.spawn(1)
                 self.position_noise[i, :length] = uniform_noise(rng, p.params.sensors.position_noise, (length,))
-                self.pressure_noise[i, :length] = uniform_noise(rng, p.params.sensors.pressure_noise, (length, 3))
+                self.pressure_noise[i, :length] = uniform_noise(pressure_rng, p.params.sensors.pressure_noise,
+                                                                (length, 3))
         self.observer = FirstOrderObserver(
             gain=np.array([p.params.observer.gain for p in self.plants]), sample_period=tick,
             initial=np.asarray(initial_position, dtype=float) + self.position_noise[:, 0])

@@ -1,6 +1,9 @@
 """A sweep's results on disk: one SQLite row per finished scenario, written in
 a transaction as each batch completes, so a crash, Ctrl-C or kill loses at most
-the scenarios in flight and a re-run skips what is done.
+the scenarios in flight and a re-run skips what is done (but retries what failed).
+
+The store records the version of the code and parameters that wrote it and
+refuses to be resumed by another, so stale numbers are never mixed in.
 """
 
 from __future__ import annotations
@@ -9,21 +12,45 @@ import json
 import pathlib
 import sqlite3
 
+from twin.exceptions import TwinError
+
 COLUMNS = ("key", "controller", "trajectory", "payload_g", "orientation", "plant", "seed", "supply_kpa",
            "pwm_period_ms", "noise", "rmse_deg", "sse_deg", "max_error_deg", "duration_s",
            "peak_spur_tooth_n", "peak_rack_tooth_n", "status", "reason", "warnings")
 
 
+class StaleStore(TwinError):
+    """A results store written by another version of the code or parameters."""
+
+
 class ResultStore:
-    def __init__(self, path: pathlib.Path):
+    def __init__(self, path: pathlib.Path, *, version: str):
         self.path = path
         self._db = sqlite3.connect(path)
         self._db.execute("PRAGMA journal_mode=WAL")
-        self._db.execute(f"CREATE TABLE IF NOT EXISTS results ({', '.join(COLUMNS)}, PRIMARY KEY (key))")
-        self._db.commit()
+        with self._db:
+            self._db.execute(f"CREATE TABLE IF NOT EXISTS results ({', '.join(COLUMNS)}, PRIMARY KEY (key))")
+            self._db.execute("CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT)")
+        try:
+            self._claim(version)
+        except StaleStore:
+            self._db.close()
+            raise
+
+    def _claim(self, version: str) -> None:
+        """Record ``version`` in a new store; refuse a store that holds another's results."""
+        row = self._db.execute("SELECT value FROM meta WHERE name = 'version'").fetchone()
+        if row is None and self._db.execute("SELECT COUNT(*) FROM results").fetchone()[0] == 0:
+            with self._db:
+                self._db.execute("INSERT INTO meta VALUES ('version', ?)", (version,))
+        elif row is None or row[0] != version:
+            written_by = "an older twin that did not record its version" if row is None else row[0]
+            raise StaleStore(f"{self.path} holds results of another version of the code or parameters "
+                             f"({written_by}; this is {version}): use a new --out folder")
 
     def done(self) -> set[str]:
-        return {row[0] for row in self._db.execute("SELECT key FROM results")}
+        """Keys of the scenarios that finished ok (a failed one is run again)."""
+        return {row[0] for row in self._db.execute("SELECT key FROM results WHERE status = 'ok'")}
 
     def add(self, records: list[dict]) -> None:
         """Persist finished scenarios atomically (all of them or none)."""

@@ -1,33 +1,74 @@
 """``twin sweep``: many scenarios, on all local cores or a Ray cluster, resumable.
 
 Scenarios are grouped by trajectory (so no run pads to a longer one) and cut
-into chunks; each chunk is one batched simulation (``twin.runner.run_many``)
-in a worker process or a Ray task, and its rows are committed to the store
-(``DIR/results.sqlite``) in one transaction as it completes. Re-running the
-same sweep skips every stored scenario. A chunk that raises is re-run one
-scenario at a time so that only the failing scenario is marked failed, with
-its reason; a scenario that raised a MuJoCo warning is marked failed too.
-Every scenario's numbers depend only on the scenario (its own noise generator,
-its own simulation), so results are bit-identical whatever the backend,
-worker count or chunking.
+into chunks, about two per worker process or per CPU of the Ray cluster; each
+chunk is one batched simulation (``twin.runner.run_many``) in a worker process
+or a Ray task, and its rows are committed to the store (``DIR/results.sqlite``)
+in one transaction as it completes. Re-running the same sweep skips every
+scenario stored ok and retries the failed ones; a store written by another
+version of the code or parameters (:func:`code_version`) is refused. A chunk
+that raises is re-run one scenario at a time so that only the failing scenario
+is marked failed, with its reason; a scenario that raised a MuJoCo warning is
+marked failed too. Every scenario's numbers depend only on the scenario (its
+own noise generator, its own simulation), so results are bit-identical
+whatever the backend, worker count or chunking.
 """
 
 from __future__ import annotations
 
 import concurrent.futures
 import dataclasses
+import hashlib
+import importlib.metadata
 import math
 import multiprocessing
 import os
 import pathlib
+import tomllib
 from collections.abc import Callable, Sequence
+from concurrent.futures.process import BrokenProcessPool
 
 from twin import report
+from twin.exceptions import TwinError
 from twin.grid import GridPoint
 from twin.store import ResultStore
 from twin.trajectories import trajectory
 
 BACKENDS = ("local", "ray")
+STORE_FORMAT = 2  # bump when a key or a column changes meaning
+PYPROJECT = pathlib.Path(__file__).resolve().parent.parent / "pyproject.toml"
+
+
+class WorkerLost(TwinError):
+    """A worker process died mid-sweep (killed, or out of memory)."""
+
+
+def _package_version() -> str:
+    try:
+        return importlib.metadata.version("hydraulic-joint-twin")
+    except importlib.metadata.PackageNotFoundError:  # run from a source tree
+        if not PYPROJECT.exists():
+            return "unknown"
+        return tomllib.loads(PYPROJECT.read_text())["project"]["version"]
+
+
+def code_version() -> str:
+    """What a stored row depends on besides its scenario: the package, MuJoCo and NumPy versions,
+    and a hash of every plant preset's parameters and of the MJCF."""
+    import mujoco
+    import numpy as np
+
+    from twin.model import MODEL_PATH
+    from twin.plants import PLANTS
+
+    params = hashlib.sha256(repr(PLANTS).encode() + MODEL_PATH.read_bytes()).hexdigest()[:16]
+    return (f"store {STORE_FORMAT}, twin {_package_version()}, mujoco {mujoco.__version__}, "
+            f"numpy {np.__version__}, params {params}")
+
+
+def open_store(out: pathlib.Path) -> ResultStore:
+    """``out/results.sqlite``; raises StaleStore if another version of the code or parameters wrote it."""
+    return ResultStore(out / "results.sqlite", version=code_version())
 
 
 def result_record(point: GridPoint, result) -> dict:
@@ -89,7 +130,8 @@ class SweepOutcome:
     ran: int
 
 
-def _local(chunks, workers: int, on_done: Callable[[list[dict]], None]) -> None:
+def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[dict]], None]) -> None:
+    chunks = make_chunks(points, workers)
     if workers == 1:
         for chunk in chunks:
             on_done(run_chunk(chunk))
@@ -105,16 +147,22 @@ def _local(chunks, workers: int, on_done: Callable[[list[dict]], None]) -> None:
             raise
 
 
-def _ray(chunks, address: str | None, on_done: Callable[[list[dict]], None]) -> None:
+def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
+         on_done: Callable[[list[dict]], None]) -> None:
+    """Chunks as Ray tasks, sized for ``workers`` or else for every CPU of the cluster."""
+    if not points:
+        return  # no cluster to start
     import ray
 
     started_here = not ray.is_initialized()
-    if started_here:
+    if started_here:  # log_to_driver=False: worker prints would flood the progress bar
         ray.init(address=address or os.environ.get("RAY_ADDRESS") or None, include_dashboard=False,
                  log_to_driver=False)
-    remote = ray.remote(run_chunk)
-    pending = [remote.remote(chunk) for chunk in chunks]
+    pending = []
     try:
+        cpus = workers or int(ray.cluster_resources().get("CPU", 1))
+        remote = ray.remote(run_chunk)
+        pending = [remote.remote(chunk) for chunk in make_chunks(points, max(1, cpus))]
         while pending:
             done, pending = ray.wait(pending, num_returns=1)
             on_done(ray.get(done[0]))
@@ -128,11 +176,12 @@ def _ray(chunks, address: str | None, on_done: Callable[[list[dict]], None]) -> 
 def run_sweep(points: Sequence[GridPoint], *, out: pathlib.Path, workers: int | None = None,
               backend: str = "local", address: str | None = None,
               progress: Callable[[int], None] | None = None) -> SweepOutcome:
-    """Run every point not yet in ``out/results.sqlite``; return all rows in grid order."""
+    """Run every point not stored ok in ``out/results.sqlite``; return all rows in grid order.
+    ``workers``: local processes (default: all cores); with Ray, the CPUs that chunks are sized for
+    (default: the cluster's)."""
     if backend not in BACKENDS:
         raise ValueError(f"unknown backend {backend!r}: choose one of {', '.join(BACKENDS)}")
-    workers = workers or os.cpu_count() or 1
-    store = ResultStore(out / "results.sqlite")
+    store = open_store(out)
     try:
         done = store.done()
         todo = [p for p in points if p.key not in done]
@@ -142,11 +191,14 @@ def run_sweep(points: Sequence[GridPoint], *, out: pathlib.Path, workers: int | 
             if progress is not None:
                 progress(len(rows))
 
-        chunks = make_chunks(todo, workers)
-        if backend == "ray":
-            _ray(chunks, address, on_done)
-        else:
-            _local(chunks, workers, on_done)
+        try:
+            if backend == "ray":
+                _ray(todo, workers, address, on_done)
+            else:
+                _local(todo, workers or os.cpu_count() or 1, on_done)
+        except BrokenProcessPool:
+            raise WorkerLost(f"a worker process died (killed, or out of memory?); the finished scenarios are kept "
+                             f"in {store.path}: run the same command again to finish the rest") from None
         return SweepOutcome(records=store.records([p.key for p in points]),
                             skipped=len(points) - len(todo), ran=len(todo))
     finally:

@@ -10,6 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from twin.whatif import AVERAGING_WINDOWS, SUSTAINED_WINDOW, window_label  # noqa: E402
 from viz.sweep_plots import plot_summary  # noqa: E402
 
 
@@ -42,19 +43,25 @@ def plot_pwm(rows: Sequence[dict], path: pathlib.Path) -> None:
                     yerr=[r["rmse_std_deg"] for r in members], marker="o", capsize=3,
                     label=f"{controller} T{trajectory}")
     ax.axvline(16, color="0.6", ls=":", label="thesis: 16 ms")
-    _finish(fig, ax, path, xlabel="PWM period (ms)", ylabel="RMSE (deg)")
+    ax.set_title("valves' PWM period only; controllers at the thesis's rates", fontsize=9)
+    _finish(fig, ax, path, xlabel="valve PWM period (ms)", ylabel="RMSE (deg)")
 
 
 def plot_gear_load(rows: Sequence[dict], path: pathlib.Path) -> None:
+    """Per run, the largest tooth force / Lewis safe load at the same tick, single ticks and sustained."""
     fig, ax = plt.subplots(figsize=(8, 4.5), constrained_layout=True)
     x = range(len(rows))
-    ax.plot(x, [r["spur_peak_n"] for r in rows], "v", color="C3", label="spur: peak over one tick")
-    ax.plot(x, [r["spur_peak_10ms_n"] for r in rows], "o", color="C0", label="spur: peak over 10 ms")
-    ax.plot(x, [r["spur_lewis_at_peak_n"] for r in rows], "_", color="k", ms=12, label="Lewis safe load at that speed")
+    for window, marker in ((AVERAGING_WINDOWS[0], "v"), (SUSTAINED_WINDOW, "o")):
+        label = window_label(window)
+        for mesh, color in (("spur", "C3"), ("pinion", "C0")):
+            ax.plot(x, [r[f"{mesh}_worst_ratio_{label}"] for r in rows], marker, color=color, ls="none",
+                    fillstyle="full" if window == SUSTAINED_WINDOW else "none",
+                    label=f"{mesh}, {window * 1e3:g} ms " + ("average" if window == SUSTAINED_WINDOW else "tick"))
+    ax.axhline(1.0, color="k", lw=0.8, label="Lewis safe load")
     ax.set_xticks(list(x), [f"{r['controller']} T{r['trajectory']} {r['payload_g']:g}g {r['supply_kpa']:g}kPa"
                             for r in rows], rotation=80, fontsize=6)
     ax.set_yscale("log")
-    _finish(fig, ax, path, xlabel="run", ylabel="tooth force (N)")
+    _finish(fig, ax, path, xlabel="run", ylabel="tooth force / Lewis safe load at that tick")
 
 
 PLOTS = {"payload": plot_summary, "lift": plot_lift, "pwm": plot_pwm, "gear-load": plot_gear_load}

@@ -1,0 +1,259 @@
+"""The joint as a meshcat scene, built from the compiled MJCF.
+
+``viz`` only reads MuJoCo: every visual geom of the model becomes a meshcat
+object under its body's node, and each frame sets the bodies' world poses from
+``MjData`` (``xpos``, ``xmat``). On top of the model's own geoms the scene adds
+what the MJCF has no geometry for:
+
+* the 7-tooth pinion, the 18-tooth spur gear and the rack teeth as real 48 DP
+  gear meshes (:mod:`viz.gear_mesh`) in place of the model's plain cylinders;
+* a water column in each cylinder, from the closed end to the piston, coloured
+  by its chamber pressure (blue at 0, red at the supply pressure);
+* the four valves V1-V4 (§4) as lamps, lit when open;
+* a ghost of the link at the desired angle (the link's pose with the racks
+  placed at the reference, through MuJoCo's kinematics);
+* an arrow along gravity.
+
+The joint is millimetres across and meshcat's camera orbits the world origin,
+so everything hangs under ``/twin``, drawn ``SCALE`` times larger with the
+output shaft at the origin, and meshcat's metre grid and axes are hidden.
+Commands are meshcat's lowered dicts: :mod:`viz.recording` packs them into
+an HTML file, :mod:`viz.live_server` streams them to a browser.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import meshcat.geometry as g
+import mujoco
+import numpy as np
+from meshcat.commands import SetObject, SetProperty, SetTransform
+from meshcat.path import Path
+
+from twin.model import JointModel
+from twin.plant_state import place_on_manifold
+from viz.gear_mesh import gear_mesh, rack_mesh
+
+ROOT = "/twin"
+SCALE = 10.0  # the scene is drawn this many times its size
+RACK_LENGTH = 24e-3  # m, drawn length of the toothed part
+RACK_BAR_HEIGHT = 0.6e-3  # m, bar under the rack teeth
+VALVE_RADIUS = 1.2e-3  # m
+VALVES = ("v1", "v2", "v3", "v4")  # V1 supplies A, V2 discharges A, V3 supplies B, V4 discharges B (§4)
+# Lamp positions in the housing frame (m): supply valves at the closed ends, discharge valves beside them.
+VALVE_POSITIONS = {
+    "v1": (-0.062, 0.0085, 0.0), "v2": (-0.054, 0.0085, 0.0),
+    "v3": (-0.062, -0.0085, 0.0), "v4": (-0.054, -0.0085, 0.0),
+}
+VALVE_OPEN_RGB = (0.2, 0.95, 0.2)
+VALVE_SHUT_RGB = (0.12, 0.12, 0.12)
+LOW_PRESSURE_RGB = np.array([0.15, 0.35, 0.75])
+HIGH_PRESSURE_RGB = np.array([0.85, 0.1, 0.1])
+CHAMBERS = {"a": ("cylinder_a_barrel", "rack_a_rod"), "b": ("cylinder_b_barrel", "rack_b_rod")}
+GHOST_RGBA = (0.9, 0.9, 0.95, 0.35)
+GRAVITY_ARROW_LENGTH = 12e-3  # m
+GRAVITY_ARROW_BASE = np.array([0.03, 0.02, 0.0])  # m, in the world, beside the joint
+SCENE_CENTRE = np.array([-0.01, 0.0, 0.0])  # m, mid-way between the valves and the swept link
+# Camera in meshcat's y-up "rotated" frame (x, world z, -world y), after SCALE: looking at
+# the plane the link turns in, from above (horizontal) or from the front (vertical).
+CAMERA_POSITION = {"horizontal": (0.0, 0.72, 0.3), "vertical": (0.0, 0.3, 0.72)}
+
+_Y_TO_Z = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # Rx(+90 deg): three.js y -> z
+
+
+def _homogeneous(rotation: np.ndarray, translation: np.ndarray, scale=(1.0, 1.0, 1.0)) -> np.ndarray:
+    matrix = np.eye(4)
+    matrix[:3, :3] = rotation @ np.diag(scale)
+    matrix[:3, 3] = translation
+    return matrix
+
+
+def _colour(rgb) -> int:
+    r, gr, b = (int(round(255 * min(max(c, 0.0), 1.0))) for c in rgb[:3])
+    return (r << 16) | (gr << 8) | b
+
+
+def _material(rgba) -> g.MeshLambertMaterial:
+    opacity = float(rgba[3])
+    return g.MeshLambertMaterial(color=_colour(rgba), opacity=opacity, transparent=opacity < 1.0)
+
+
+def pressure_rgb(pressure: float, supply: float) -> tuple[float, float, float]:
+    """Chamber colour: blue at 0 Pa, red at the supply pressure."""
+    share = min(max(pressure / supply, 0.0), 1.0) if supply > 0 else 0.0
+    return tuple(float(c) for c in (1.0 - share) * LOW_PRESSURE_RGB + share * HIGH_PRESSURE_RGB)
+
+
+@dataclasses.dataclass
+class Frame:
+    """One picture of the joint: world poses (4x4, m) and colours (rgb) by meshcat path."""
+
+    transforms: dict[str, np.ndarray]
+    colours: dict[str, tuple[float, float, float]]
+
+
+class JointScene:
+    """The meshcat scene of one compiled joint; see the module docstring."""
+
+    def __init__(self, joint: JointModel, *, supply_pressure: float):
+        self.joint = joint
+        self.model = joint.model
+        self.supply = supply_pressure  # Pa, for the chamber colour scale
+        self.kinematics = mujoco.MjData(self.model)  # poses of replayed states
+        self.ghost_data = mujoco.MjData(self.model)  # poses at the desired angle
+        self.body_names = [self.model.body(b).name for b in range(1, self.model.nbody)]
+        self.link_body = self.model.body("link").id
+        self.housing_body = self.model.body("housing").id
+
+    # -- the scene, sent once ------------------------------------------------
+    def setup_commands(self) -> list[dict]:
+        """Objects, their fixed offsets, the camera and the hidden grid: send once per model."""
+        commands = [SetProperty("visible", False, Path(("Grid",))).lower(),
+                    SetProperty("visible", False, Path(("Axes",))).lower(),
+                    SetTransform(_homogeneous(SCALE * np.eye(3), -SCALE * SCENE_CENTRE), Path(("twin",))).lower()]
+        camera = CAMERA_POSITION[self.joint.orientation.value]
+        commands.append(SetProperty("position", list(camera),
+                                    Path(("Cameras", "default", "rotated", "<object>"))).lower())
+        for geom in range(self.model.ngeom):
+            rgba = self._rgba(geom)
+            if rgba[3] <= 0.0:
+                continue  # the empty payload's placeholder
+            body = self.body_names[self.model.geom_bodyid[geom] - 1]
+            path = Path(("twin", "bodies", body, self.model.geom(geom).name))
+            geometry, offset = self._geometry(geom)
+            commands.append(SetObject(geometry, _material(rgba), path).lower())
+            commands.append(SetTransform(offset, path).lower())
+            if body == "link":
+                ghost = Path(("twin", "ghost", self.model.geom(geom).name))
+                commands.append(SetObject(geometry, _material(GHOST_RGBA), ghost).lower())
+                commands.append(SetTransform(offset, ghost).lower())
+        for name, (barrel, _) in CHAMBERS.items():
+            radius = 1.1 * float(self.model.geom_size[self.model.geom(barrel).id][0])
+            commands.append(SetObject(g.Cylinder(1.0, radius), _material((*LOW_PRESSURE_RGB, 0.85)),
+                                      Path(("twin", "chambers", name))).lower())
+        for name in VALVES:
+            commands.append(SetObject(g.Sphere(VALVE_RADIUS), _material((*VALVE_SHUT_RGB, 1.0)),
+                                      Path(("twin", "bodies", "housing", "valves", name))).lower())
+            commands.append(SetTransform(_homogeneous(np.eye(3), np.array(VALVE_POSITIONS[name])),
+                                         Path(("twin", "bodies", "housing", "valves", name))).lower())
+        commands.extend(self._gravity_arrow())
+        return commands
+
+    def _rgba(self, geom: int) -> np.ndarray:
+        material = self.model.geom_matid[geom]
+        return self.model.mat_rgba[material] if material >= 0 else self.model.geom_rgba[geom]
+
+    def _geometry(self, geom: int) -> tuple[g.Geometry, np.ndarray]:
+        """A meshcat geometry for a MuJoCo geom and its transform in the body frame."""
+        m = self.model
+        name, size = m.geom(geom).name, m.geom_size[geom]
+        rotation = np.empty(9)
+        mujoco.mju_quat2Mat(rotation, m.geom_quat[geom])
+        rotation = rotation.reshape(3, 3)
+        position = m.geom_pos[geom].copy()
+        gears = self.joint.params.gears
+        module = 0.0254 / gears.diametral_pitch
+        if name == "pinion_body":
+            return _mesh(gear_mesh(gears.pinion_teeth, module, 2 * size[1])), _homogeneous(rotation, position)
+        if name == "spur_body":  # half a tooth turned: a gap of the spur faces the pinion's tooth 0 on +x
+            half_pitch = np.pi / gears.spur_teeth
+            turn = np.array([[np.cos(half_pitch), -np.sin(half_pitch), 0.0],
+                             [np.sin(half_pitch), np.cos(half_pitch), 0.0], [0.0, 0.0, 1.0]])
+            return _mesh(gear_mesh(gears.spur_teeth, module, 2 * size[1])), _homogeneous(rotation @ turn, position)
+        if name in ("rack_a_bar", "rack_b_bar"):
+            # Teeth toward the pinion, pitch line on the pinion's pitch circle (the body's origin).
+            facing = np.diag([1.0, -1.0, -1.0]) if position[1] > 0 else np.eye(3)
+            mesh = rack_mesh(RACK_LENGTH, module, 2 * size[2], RACK_BAR_HEIGHT)
+            return _mesh(mesh), _homogeneous(facing, np.array([position[0], 0.0, 0.0]))
+        kind = m.geom_type[geom]
+        if kind == mujoco.mjtGeom.mjGEOM_BOX:
+            return g.Box(list(2 * size)), _homogeneous(rotation, position)
+        if kind == mujoco.mjtGeom.mjGEOM_SPHERE:
+            return g.Sphere(float(size[0])), _homogeneous(rotation, position)
+        if kind == mujoco.mjtGeom.mjGEOM_CYLINDER:
+            return g.Cylinder(2 * float(size[1]), float(size[0])), _homogeneous(rotation @ _Y_TO_Z, position)
+        raise ValueError(f"geom {name!r}: no meshcat shape for MuJoCo geom type {kind}")
+
+    def _gravity_arrow(self) -> list[dict]:
+        gravity = self.model.opt.gravity
+        down = gravity / np.linalg.norm(gravity)
+        # A rotation taking three.js's cylinder axis (y) onto -gravity, so the cone's tip points down.
+        up = -down
+        helper = np.array([1.0, 0.0, 0.0]) if abs(up[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        x = np.cross(up, helper)
+        x /= np.linalg.norm(x)
+        rotation = np.column_stack([x, up, np.cross(x, up)])
+        shaft, head = 0.7 * GRAVITY_ARROW_LENGTH, 0.3 * GRAVITY_ARROW_LENGTH
+        base = GRAVITY_ARROW_BASE
+        grey = _material((0.3, 0.3, 0.3, 1.0))
+        return [
+            SetObject(g.Cylinder(shaft, 0.4e-3), grey, Path(("twin", "gravity", "shaft"))).lower(),
+            SetTransform(_homogeneous(rotation, base - up * shaft / 2), Path(("twin", "gravity", "shaft"))).lower(),
+            SetObject(g.Cylinder(head, radiusTop=1.2e-3, radiusBottom=0.0), grey,
+                      Path(("twin", "gravity", "head"))).lower(),
+            SetTransform(_homogeneous(rotation, base - up * (shaft + head / 2)),
+                         Path(("twin", "gravity", "head"))).lower(),
+        ]
+
+    # -- a frame, sent as often as the picture changes -----------------------
+    def frame(self, data: mujoco.MjData, *, desired_angle: float, pressures: tuple[float, float],
+              valve_open) -> Frame:
+        """The poses in ``data`` (kinematics done), the ghost at ``desired_angle`` (rad), the
+        chamber pressures (Pa) and valves V1-V4 (bool) as one :class:`Frame`."""
+        transforms = {f"{ROOT}/bodies/{name}": _homogeneous(data.xmat[b].reshape(3, 3), data.xpos[b])
+                      for b, name in enumerate(self.body_names, start=1)}
+        transforms[f"{ROOT}/ghost"] = self._ghost_pose(desired_angle)
+        colours = {}
+        for (name, (barrel, rod)), pressure in zip(CHAMBERS.items(), pressures, strict=True):
+            transforms[f"{ROOT}/chambers/{name}"] = self._chamber_pose(data, barrel, rod)
+            colours[f"{ROOT}/chambers/{name}/<object>"] = pressure_rgb(float(pressure), self.supply)
+        for name, is_open in zip(VALVES, valve_open, strict=True):
+            colours[f"{ROOT}/bodies/housing/valves/{name}/<object>"] = (
+                VALVE_OPEN_RGB if is_open else VALVE_SHUT_RGB)
+        return Frame(transforms=transforms, colours=colours)
+
+    def replay_frame(self, *, rack_position: float, angle: float, desired_angle: float,
+                     pressures: tuple[float, float], valve_open) -> Frame:
+        """A recorded state: racks and pinion at ``rack_position`` (m), the output at ``angle`` (rad)."""
+        self._place(self.kinematics, rack_position)
+        self.kinematics.qpos[self.joint.spur_dof] = angle
+        mujoco.mj_kinematics(self.model, self.kinematics)
+        return self.frame(self.kinematics, desired_angle=desired_angle, pressures=pressures, valve_open=valve_open)
+
+    def _place(self, data: mujoco.MjData, rack_position: float) -> None:
+        qpos = data.qpos[None, :].copy()
+        place_on_manifold(qpos, self.joint, np.array([rack_position]))
+        data.qpos[:] = qpos[0]
+
+    def _ghost_pose(self, desired_angle: float) -> np.ndarray:
+        self._place(self.ghost_data, desired_angle * self.joint.params.gears.spur_radius)
+        mujoco.mj_kinematics(self.model, self.ghost_data)
+        b = self.link_body
+        return _homogeneous(self.ghost_data.xmat[b].reshape(3, 3), self.ghost_data.xpos[b])
+
+    def _chamber_pose(self, data: mujoco.MjData, barrel: str, rod: str) -> np.ndarray:
+        """Water column from the barrel's closed end to the piston (the rod's far end)."""
+        b, r = self.model.geom(barrel).id, self.model.geom(rod).id
+        barrel_axes = data.geom_xmat[b].reshape(3, 3)
+        axis = barrel_axes[:, 2]
+        closed_end = data.geom_xpos[b] - axis * self.model.geom_size[b][1]
+        piston = data.geom_xpos[r] - data.geom_xmat[r].reshape(3, 3)[:, 2] * self.model.geom_size[r][1]
+        length = max(float(np.dot(piston - closed_end, axis)), 0.5e-3)
+        return _homogeneous(barrel_axes @ _Y_TO_Z, closed_end + axis * length / 2, scale=(1.0, length, 1.0))
+
+
+def _mesh(mesh) -> g.TriangularMeshGeometry:
+    vertices, faces = mesh
+    return g.TriangularMeshGeometry(np.asarray(vertices, dtype=np.float32), np.asarray(faces, dtype=np.uint32))
+
+
+def frame_commands(frame: Frame) -> list[dict]:
+    """meshcat commands that show ``frame`` (live viewing)."""
+    commands = [SetTransform(matrix, Path(tuple(path.strip("/").split("/")))).lower()
+                for path, matrix in frame.transforms.items()]
+    commands += [SetProperty("color", [*rgb, 0.85 if "chambers" in path else 1.0],
+                             Path(tuple(path.strip("/").split("/")))).lower()
+                 for path, rgb in frame.colours.items()]
+    return commands
+
