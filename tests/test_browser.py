@@ -88,8 +88,9 @@ def wait_for_animation(page) -> None:
 
 
 def body_rotation(page, body: str) -> np.ndarray:
-    """The 3x3 rotation of a body's node as three.js holds it (column-major ``matrix``)."""
-    elements = page.evaluate(f"Array.from(viewer.scene_tree.find(['twin', 'bodies', '{body}']).object.matrix.elements)")
+    """The 3x3 rotation of a body's node as three.js holds it (its ``matrix``, refreshed from its pose)."""
+    elements = page.evaluate(f"(() => {{ const o = viewer.scene_tree.find(['twin', 'bodies', '{body}']).object; "
+                             "o.updateMatrix(); return Array.from(o.matrix.elements); })()")
     return np.array(elements).reshape(4, 4).T[:3, :3]
 
 
@@ -125,7 +126,7 @@ def test_recording_plays_offline_and_moves_by_the_trace(tmp_path, page):
     poses = {}
     for t in (0.4, 0.6):
         page.evaluate(f"viewer.animator.pause(); viewer.animator.seek({t});")
-        page.wait_for_timeout(400)  # a render: three.js refreshes ``matrix`` from the animated pose
+        page.wait_for_timeout(400)  # a render, for the screenshot
         poses[t] = {body: body_rotation(page, body) for body in ("spur", "link", "pinion")}
         if t == 0.6:
             assert_scene_rendered(screenshot(page, "recording.png"))
@@ -142,24 +143,27 @@ def test_recording_plays_offline_and_moves_by_the_trace(tmp_path, page):
 
 @pytest.fixture
 def live_twin():
+    ARTIFACTS.mkdir(exist_ok=True)
+    log = open(ARTIFACTS / "twin-view.stderr.txt", "w")  # read when a test fails; never a full pipe
     proc = subprocess.Popen(
         [sys.executable, "-m", "twin", "view", "--controller", "smc", "--trajectory", "4", "--port", "0",
-         "--duration", "600"],
-        cwd=ROOT, env=twin_env(), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+         "--duration", "900"],
+        cwd=ROOT, env=twin_env(), stdout=subprocess.PIPE, stderr=log, text=True)
     line = proc.stdout.readline()
     match = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
-    assert match, f"no URL in {line!r}; stderr: {proc.stderr.read() if proc.poll() is not None else ''}"
+    assert match, f"no URL in {line!r}; stderr: {(ARTIFACTS / 'twin-view.stderr.txt').read_text()}"
     yield proc, match.group(0), int(match.group(1))
     if proc.poll() is None:
         proc.kill()
         proc.wait(10)
+    log.close()
 
 
 def readout(page) -> dict:
     return page.evaluate("window.twinLast")
 
 
-def wait_until(page, condition, timeout: float = 30.0, what: str = "") -> dict:
+def wait_until(page, condition, timeout: float = 180.0, what: str = "") -> dict:
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         last = readout(page)
@@ -205,7 +209,7 @@ def test_live_page_follows_the_slider_and_refuses_bad_messages(live_twin, page):
     page.wait_for_function("window.twinState.orientation === 'vertical'", timeout=30_000)
     wait_until(page, lambda r: r["time"] < 2.0, what="the restarted run")
     page.click("text=T1")
-    wait_until(page, lambda r: r["desired_deg"] > 100.0, timeout=40.0, what="T1's replay to rise")
+    wait_until(page, lambda r: r["desired_deg"] > 100.0, what="T1's replay to rise")
     assert_scene_rendered(screenshot(page, "live-vertical.png"))
 
     proc.send_signal(signal.SIGINT)

@@ -280,3 +280,50 @@ def test_live_recording_keeps_every_fiftieth_of_a_second(tmp_path):
     spur = next(a for a in animation["animations"] if a["path"] == "/twin/bodies/spur")
     quaternions = next(t for t in spur["clip"]["tracks"] if t["name"] == ".quaternion")
     assert len(quaternions["keys"]) == 76 and spur["clip"]["fps"] == 50
+
+
+@pytest.mark.parametrize("rack, contact", [("a", math.pi / 2), ("b", -math.pi / 2)])
+def test_rack_teeth_fill_the_pinion_gap_and_cover_the_travel(rack, contact):
+    from viz.scene import rack_teeth_layout
+
+    joint = compile_joint()
+    travel = tuple(joint.model.jnt_range[joint.model.joint(f"rack_{rack}").id])
+    module, pitch = 0.0254 / 48, math.pi * 0.0254 / 48
+    length, centre = rack_teeth_layout(travel=travel, teeth=7, pinion_radius=R_PINION, module=module,
+                                       contact_angle=contact)
+    count = round(length / pitch)
+    teeth = centre + (np.arange(count) - (count - 1) / 2) * pitch
+    gaps = (np.arange(7) + 0.5) * 2 * math.pi / 7  # pinion tooth 0 on +x
+    side = np.sin(gaps) * np.sign(math.sin(contact)) > 0
+    nearest_gap_x = min(R_PINION * np.cos(gaps[side]), key=abs)  # the gap facing this rack, nearest the contact
+    assert min(abs(teeth - nearest_gap_x)) < 0.01e-3  # a rack tooth sits in it (arc vs chord: 2 um)
+    contact_x = [-travel[1], -travel[0]]  # where the pinion meets the rack, in the rack's frame
+    assert teeth.min() < contact_x[0] - pitch and teeth.max() > contact_x[1] + pitch
+
+
+def test_a_huge_number_is_a_bad_message_not_a_crash():
+    with pytest.raises(live_messages.BadMessage, match=r"\[0, 180\] deg"):
+        live_messages.parse('{"type": "target", "angle_deg": ' + "9" * 400 + "}")
+    with pytest.raises(live_messages.BadMessage, match="too long"):
+        live_messages.parse('{"type": "target", "angle_deg": 90, "x": "' + "é" * 600 + '"}')  # 1200 bytes
+
+
+def test_a_failing_simulation_stops_once_and_tells_the_page():
+    session = LiveSession(Scenario("ffpva", 1, seed=0))
+    viewer = LiveViewer(session, port=0)
+    try:
+        sent, stopped = [], []
+        viewer.broadcast = sent.extend
+        viewer.clock = type("Clock", (), {"stop": lambda self: stopped.append(True)})()
+        viewer._last = 0.0
+
+        def broken(duration):
+            raise RuntimeError("boom")
+
+        session.advance = broken
+        viewer._tick()
+    finally:
+        for sock in viewer.sockets:
+            sock.close()
+    assert stopped == [True] and viewer.failure == "simulation stopped: boom"
+    assert json.loads(sent[0]) == {"type": "error", "message": "simulation stopped: boom"}

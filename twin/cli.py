@@ -4,6 +4,7 @@
     twin run --controller ffpva --trajectory 1 --json      one scenario
     twin bench                     cost per simulated second
     twin view --controller smc --trajectory 4              the joint live in a browser
+    twin study robustness --out DIR                        the thesis's Chapter 6 protocol
 
 Degrees, grams and kPa here; SI inside. Bad input gets a one-line error and
 exit code 2, and nothing is written.
@@ -16,6 +17,7 @@ import json
 import math
 import os
 import pathlib
+import signal
 import sys
 import time
 
@@ -130,14 +132,47 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if args.duration is not None:
         stop_at = time.monotonic() + args.duration
         viewer.on_frame = lambda: viewer.stop() if time.monotonic() >= stop_at else None
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # stop (and write --html) on SIGTERM too
     try:
         viewer.start()
     except KeyboardInterrupt:
         viewer.stop()
     print("twin view: stopped", flush=True)
     if args.html is not None:
-        session.write_html(args.html)
+        print(f"writing {args.html} ...", flush=True)
+        try:
+            session.write_html(args.html)
+        except KeyboardInterrupt:
+            print("twin view: interrupted; no recording written", file=sys.stderr)
+            return 130
         print(f"wrote {args.html}", flush=True)
+    return 1 if viewer.failure else 0
+
+
+def _cmd_calibrate(args: argparse.Namespace) -> int:
+    from twin import calibrate
+    from twin.as_built import CALIBRATION_FILE
+    from viz.calibration_plots import plot_calibration
+
+    args.out.mkdir(exist_ok=True)
+
+    def progress(done: int, cost: float, values: dict) -> None:
+        shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
+        print(f"[{done}/{args.max_evaluations}] cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
+
+    if args.max_evaluations is None:
+        args.max_evaluations = calibrate.MAX_EVALUATIONS
+    result = calibrate.calibrate(workers=args.workers, max_evaluations=args.max_evaluations, progress=progress)
+    data = calibrate.record(result, max_evaluations=args.max_evaluations, fit_seeds=calibrate.FIT_SEEDS,
+                            check_seeds=calibrate.CHECK_SEEDS)
+    path = calibrate.write(data, args.out)
+    plot_calibration(data["residuals_check_seeds"], data["history"], args.out / "calibration.png")
+    print(calibrate.format_residuals(data))
+    print(f"wrote {path} and {args.out / 'calibration.png'} ({result.evaluations} evaluations, "
+          f"{result.wall_time:.0f} s)")
+    if args.install:
+        CALIBRATION_FILE.write_text(path.read_text())
+        print(f"installed as the as-built preset: {CALIBRATION_FILE}")
     return 0
 
 
@@ -262,6 +297,44 @@ def _cmd_whatif(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_study(args: argparse.Namespace) -> int:
+    from twin import studies
+    from twin.plants import plant
+
+    plant_name = args.plant or studies.default_plant("thesis" if args.study == "robustness" else "thesis-pwm")
+    plant(plant_name)  # an unknown name is a one-line error before anything is written
+    args.out.mkdir(exist_ok=True)
+    if args.study == "robustness":
+        from tqdm import tqdm
+
+        from viz.study_plots import plot_robustness
+
+        points = studies.robustness_grid(plant_name=plant_name, seeds=args.seeds)
+        print(f"{len(points)} runs on the {plant_name} plant -> {args.out.resolve()}", file=sys.stderr)
+        try:
+            with tqdm(total=len(points), unit="run", file=sys.stderr, dynamic_ncols=True, desc="robustness") as bar:
+                study = studies.robustness_study(out=args.out, plant_name=plant_name, seeds=args.seeds,
+                                                 workers=args.workers, progress=bar.update)
+        except KeyboardInterrupt:
+            print(f"interrupted: finished runs are kept in {args.out / 'results.sqlite'}; "
+                  "run the same command again to finish the rest", file=sys.stderr)
+            return 130
+        paths = studies.write_robustness(study, args.out) + [args.out / "robustness.png"]
+        plot_robustness(study.summary, paths[-1])
+        print(studies.format_robustness(study))
+        failed = bool(study.failed)
+    else:
+        from viz.study_plots import plot_openloop
+
+        study = studies.openloop_study(plant_name=plant_name)
+        paths = [studies.write_openloop(study, args.out), args.out / "openloop.png"]
+        plot_openloop(study, paths[-1])
+        print(study.answer)
+        failed = any(run.warnings for run in study.runs)
+    print(f"wrote {', '.join(str(p) for p in paths)}")
+    return 1 if failed else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(prog="twin", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
@@ -303,6 +376,19 @@ def build_parser() -> argparse.ArgumentParser:
     whatif.add_argument("--workers", type=_positive_int, default=None)
     whatif.set_defaults(func=_cmd_whatif)
 
+    study = sub.add_parser("study", help="the thesis's robustness protocol (ch. 6) and open-loop validation (4.6)")
+    studies = study.add_subparsers(dest="study", required=True, parser_class=_Parser)
+    robustness = studies.add_parser("robustness", help="FF + PVA and sliding mode, T1 and T3, 0/6.5/13.5 g, "
+                                    "horizontal and vertical, 5 seeds (SPEC §9)")
+    robustness.add_argument("--seeds", type=_positive_int, default=5, help="noise seeds per case (default 5)")
+    robustness.add_argument("--workers", type=_positive_int, default=None, help="processes (default: all cores)")
+    openloop = studies.add_parser("openloop", help="sine duty with soft limits, thesis model against a plant (SPEC §4)")
+    for parser_ in (robustness, openloop):
+        parser_.add_argument("--plant", default=None, metavar="NAME",
+                             help="default: as-built if present, else thesis (robustness) or thesis-pwm (openloop)")
+        parser_.add_argument("--out", type=_out_dir, required=True, metavar="DIR", help="output folder (created)")
+        parser_.set_defaults(func=_cmd_study)
+
     run = sub.add_parser("run", help="simulate one scenario")
     add_scenario_arguments(run)
     run.add_argument("--trace", type=_writable_file(".csv"), metavar="FILE.csv", help="write the time series")
@@ -311,6 +397,16 @@ def build_parser() -> argparse.ArgumentParser:
     run.add_argument("--html", type=_writable_file(".html"), metavar="FILE.html",
                      help="write a self-contained 3D recording with its traces")
     run.set_defaults(func=_cmd_run)
+
+    cal = sub.add_parser("calibrate", help="fit the as-built plant to the thesis's experiments (SPEC §8)")
+    cal.add_argument("--out", type=_out_dir, required=True, metavar="DIR", help="results folder (created)")
+    cal.add_argument("--workers", type=_positive_int, default=max(1, min(os.cpu_count() or 1, 4)),
+                     help="processes (default: the cores, at most 4)")
+    cal.add_argument("--max-evaluations", type=_positive_int, default=None, metavar="N",
+                     help="optimiser budget (default: twin.calibrate.MAX_EVALUATIONS)")
+    cal.add_argument("--install", action="store_true",
+                     help="also make the result the as-built preset (twin/data/as_built.json)")
+    cal.set_defaults(func=_cmd_calibrate)
 
     view = sub.add_parser("view", help="the joint live in a browser (3D view and control panel)")
     add_scenario_arguments(view)

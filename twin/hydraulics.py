@@ -88,12 +88,14 @@ class RackForces:
 
 def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_area: float,
               y: np.ndarray, v0: np.ndarray, external_force: np.ndarray, stuck: np.ndarray,
-              mass: np.ndarray, h: float) -> RackForces:
+              mass: np.ndarray, h: float, breakaway: np.ndarray | None = None) -> RackForces:
     """Forces on the racks over one step ``h`` from rack position ``y`` (m) and velocity ``v0`` (m/s).
 
     ``external_force`` (N) is everything else along +y (gravity through the gears);
     ``stuck`` says whether the rack was at rest (stiction applies); ``mass`` (kg)
-    is the train's inertia referred to the rack.
+    is the train's inertia referred to the rack; ``breakaway`` (N) the static
+    friction at ``y`` if it varies along the stroke (default: the constant
+    ``friction_params.stiction``).
     """
     sealed = circuit_now.sealed
     c_h = np.where(sealed, 0.0, circuit_now.damping)
@@ -103,7 +105,8 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
     # Friction force that would stop the rack in this step (damping vanishes at v1 = 0).
     to_stop = -(momentum_force + drive + external_force)
     coulomb = friction.coulomb_force(friction_params, y, -np.sign(to_stop))
-    limit = np.where(stuck, np.maximum(coulomb, friction_params.stiction), coulomb)
+    static = friction_params.stiction if breakaway is None else breakaway
+    limit = np.where(stuck, np.maximum(coulomb, static), coulomb)
     sticks = sealed | (np.abs(to_stop) <= limit)
     dry = np.where(sealed, 0.0, np.where(sticks, to_stop, np.sign(to_stop) * limit))
     v1 = np.where(sticks, 0.0, (v0 + h * (drive + external_force + dry) / mass) / (1.0 + h * c_total / mass))

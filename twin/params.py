@@ -193,6 +193,108 @@ class ObserverParams:
 
 
 @dataclasses.dataclass(frozen=True)
+class ChamberParams:
+    """Compressible chambers (as-built; §3: "trapped air lowers" beta).
+
+    Off (``compressible=False``) the water is incompressible and a sealed
+    chamber locks the joint, as the thesis modelled it. On, each chamber's
+    pressure is a state: dP/dt = beta_eff(P) / V(y) (Q_in - Q_out -+ A v), with
+    free air (isothermal) lowering the bulk modulus at low pressure:
+    1 / beta_eff = 1 / beta_w + x_air p_atm / p_abs^2.
+    """
+
+    compressible: bool = False
+    water_bulk_modulus: float = 2.19e9  # Pa, beta of water (§3)
+    air_fraction: float = 0.0  # x_air: free air volume per chamber volume at atmospheric pressure (calibrated)
+    dead_volume: float = 0.3e-6  # m^3 per chamber at the end of stroke: ports, hose to the valves (*assumed*)
+    leak_conductance: float = 0.0  # m^3/(Pa s) past each shut valve to the tank: pressure decays when closed
+    initial_pressure_fraction: float = 0.5  # of the supply, in both chambers at the start (*assumed*: the
+    # thesis pre-charges by moving the joint side to side; shut valves then trap a middle pressure)
+    atmospheric_pressure: float = 101.325e3  # Pa
+    substeps: int = 10  # implicit sub-steps of the chamber/rack/supply model per physics tick
+
+    def __post_init__(self) -> None:
+        _require_positive(self, "water_bulk_modulus", "dead_volume", "atmospheric_pressure")
+        if not 0.0 <= self.air_fraction <= 0.2:
+            raise InvalidParameter(f"air_fraction must be in [0, 0.2], got {self.air_fraction}")
+        if self.leak_conductance < 0 or self.substeps < 1:
+            raise InvalidParameter("leak_conductance must be >= 0 and substeps >= 1")
+
+
+@dataclasses.dataclass(frozen=True)
+class SupplyLineParams:
+    """The supply between the air-over-water cylinder and the valves (as-built; §3, §10).
+
+    ``model``: ``constant`` (the thesis: P_ws fixed); ``line`` (the air-over-water
+    cylinder feeding the valves through a hose: series resistance R and inertance L
+    into a compliance C at the valve block, so the pressure there sags while water
+    flows, rings at f_n = 1 / (2 pi sqrt(L C)) and recovers when flow stops);
+    ``accumulator`` (the same line with a gas accumulator of ``accumulator_compliance``
+    added at the valve block, thesis future work 1).
+    """
+
+    model: str = "constant"
+    compliance: float = 2e-13  # m^3/Pa, C: hose wall and water at the valve block (calibrated)
+    natural_frequency: float = 60.0  # Hz, f_n of the line with C (calibrated)
+    damping_ratio: float = 0.3  # zeta of the line with C (calibrated)
+    accumulator_compliance: float = 2e-11  # m^3/Pa, a 10 mL gas accumulator at 400 kPa abs (V / (gamma p))
+
+    def __post_init__(self) -> None:
+        if self.model not in ("constant", "line", "accumulator"):
+            raise InvalidParameter(f"supply model must be constant, line or accumulator, got {self.model!r}")
+        _require_positive(self, "compliance", "natural_frequency", "accumulator_compliance")
+        if not self.damping_ratio > 0:
+            raise InvalidParameter(f"damping_ratio must be positive, got {self.damping_ratio}")
+
+    @property
+    def inertance(self) -> float:
+        """L = 1 / (omega_n^2 C) in Pa s^2/m^3."""
+        return 1.0 / ((2.0 * math.pi * self.natural_frequency) ** 2 * self.compliance)
+
+    @property
+    def resistance(self) -> float:
+        """R = 2 zeta sqrt(L / C) in Pa s/m^3."""
+        return 2.0 * self.damping_ratio * math.sqrt(self.inertance / self.compliance)
+
+
+@dataclasses.dataclass(frozen=True)
+class HallParams:
+    """What the Hall sensor reading is in the as-built joint (§5).
+
+    ``calibration_error``: the DAQ turns volts into degrees with the quadratic
+    fit eq. 4.2.1, but the sensor's true volts-angle curve is the one through the
+    measured calibration points (piecewise linear between them), so the reading
+    is off by the fit's residual (up to a few degrees).
+    """
+
+    calibration_error: bool = False
+    fit: tuple[float, float, float] = (-9.122, -25.58, 244.94)  # deg = a x^2 + b x + c, x in V (eq. 4.2.1)
+    # (deg, V) measured calibration points (§5); protractor accuracy +-0.5 deg.
+    points: tuple[tuple[float, float], ...] = (
+        (3, 3.866), (24, 3.793), (53, 3.408), (55, 3.378), (66, 3.244), (69, 3.215), (94, 2.866), (97, 2.828),
+        (106, 2.711), (125, 2.510), (126, 2.494), (138, 2.320), (156, 2.047), (174, 1.706), (176, 1.671))
+
+
+@dataclasses.dataclass(frozen=True)
+class StictionMapParams:
+    """Static friction that varies along the stroke (as-built; thesis future work 2).
+
+    Breakaway force F_s(y) = stiction + scatter u_k, piecewise linear between knots
+    ``knot_spacing`` apart over the rack's stroke, u_k uniform in [-1, 1] from
+    ``seed`` (one map per joint, not per run). scatter = 0: a constant F_s.
+    """
+
+    scatter: float = 0.0  # N (calibrated)
+    knot_spacing: float = 1e-3  # m
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        _require_positive(self, "knot_spacing")
+        if self.scatter < 0:
+            raise InvalidParameter(f"stiction scatter must be >= 0, got {self.scatter}")
+
+
+@dataclasses.dataclass(frozen=True)
 class JointParams:
     """The whole joint: one typed place for every SPEC number."""
 
@@ -204,6 +306,10 @@ class JointParams:
     supply: SupplyParams = SupplyParams()
     sensors: SensorParams = SensorParams()
     observer: ObserverParams = ObserverParams()
+    chambers: ChamberParams = ChamberParams()
+    supply_line: SupplyLineParams = SupplyLineParams()
+    hall: HallParams = HallParams()
+    stiction_map: StictionMapParams = StictionMapParams()
     gravity: float = 9.81  # m/s^2
 
 

@@ -22,11 +22,14 @@ from collections.abc import Sequence
 import numpy as np
 
 from twin import hydraulics
+from twin.chambers import CompressibleCircuit
 from twin.control import Measurement
+from twin.hall import HallReading
 from twin.model import JointModel
 from twin.plants import Plant
 from twin.scenario import Scenario
 from twin.sensing import FirstOrderObserver, uniform_noise
+from twin.stiction_map import StictionMap
 from twin.valves import ValveBank
 
 
@@ -72,23 +75,40 @@ class PlantState:
                 self.position_noise[i, :length] = uniform_noise(rng, p.params.sensors.position_noise, (length,))
                 self.pressure_noise[i, :length] = uniform_noise(pressure_rng, p.params.sensors.pressure_noise,
                                                                 (length, 3))
-        self.observer = FirstOrderObserver(
-            gain=np.array([p.params.observer.gain for p in self.plants]), sample_period=tick,
-            initial=np.asarray(initial_position, dtype=float) + self.position_noise[:, 0])
-        self._plant_groups = [
-            (preset, idx, ValveBank(params=preset.params.valves, model=preset.valve_model, n=len(idx), tick=tick))
-            for preset, idx in groups(self.plants).items()]
+        model = joints[0].model
+        stroke = tuple(float(x) for x in model.jnt_range[model.dof_jntid[joints[0].rack_a_dof]])
+        start = np.asarray(initial_position, dtype=float)
+        self._plant_groups = [_PlantGroup(preset, idx, tick=tick, stroke=stroke, supply=self.supply[idx])
+                              for preset, idx in groups(self.plants).items()]
         self.conductance = np.zeros((n, 4))  # m^3/(Pa s), V1..V4
         self.stuck = np.ones(n, dtype=bool)
         self.pressure_a = np.zeros(n)  # Pa
         self.pressure_b = np.zeros(n)  # Pa
+        self.supply_now = self.supply.copy()  # Pa, at the valve block (varies with an as-built supply line)
+        for group in self._plant_groups:
+            if group.chambers is not None:
+                self.pressure_a[group.idx] = group.chambers.state.pressure_a
+                self.pressure_b[group.idx] = group.chambers.state.pressure_b
+        self.observer = FirstOrderObserver(
+            gain=np.array([p.params.observer.gain for p in self.plants]), sample_period=tick,
+            initial=self._hall(start) + self.position_noise[:, 0])
+
+    def _hall(self, y: np.ndarray) -> np.ndarray:
+        """The rack position the Hall sensor reports for the true ``y``, before noise."""
+        if all(group.hall is None for group in self._plant_groups):
+            return y
+        read = y.copy()
+        for group in self._plant_groups:
+            if group.hall is not None:
+                read[group.idx] = group.hall(y[group.idx])
+        return read
 
     def sense(self, k: int, y: np.ndarray) -> Measurement:
         """Sample the sensors at tick k from the true rack position ``y`` (n,)."""
-        measured = y + self.position_noise[:, k]
+        measured = self._hall(y) + self.position_noise[:, k]
         velocity, acceleration = self.observer.update(measured)
         return Measurement(position=measured, velocity=velocity, acceleration=acceleration,
-                           supply_pressure=self.supply + self.pressure_noise[:, k, 2])
+                           supply_pressure=self.supply_now + self.pressure_noise[:, k, 2])
 
     def measured_pressures(self, k: int) -> tuple[np.ndarray, np.ndarray]:
         """Chamber pressures A and B as the pressure sensors read them (Pa)."""
@@ -102,14 +122,49 @@ class PlantState:
                 external: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Piston forces (cylinder A, cylinder B) in N for the duty command (n,) in %."""
         force_a, force_b = np.zeros(self.n), np.zeros(self.n)
-        for preset, idx, bank in self._plant_groups:
-            self.conductance[idx] = bank.update(k, duty[idx])
-            area = preset.params.cylinder.bore_area
-            forces = hydraulics.rack_step(
-                circuit_now=hydraulics.circuit(self.conductance[idx], self.supply[idx], area),
-                friction_params=preset.params.friction, bore_area=area, y=y[idx], v0=v[idx],
-                external_force=external[idx], stuck=self.stuck[idx], mass=self.mass[idx], h=self.tick)
+        for group in self._plant_groups:
+            idx, params = group.idx, group.preset.params
+            self.conductance[idx] = group.valves.update(k, duty[idx])
+            area = params.cylinder.bore_area
+            if group.chambers is None:
+                forces = hydraulics.rack_step(
+                    circuit_now=hydraulics.circuit(self.conductance[idx], self.supply[idx], area),
+                    friction_params=params.friction, bore_area=area, y=y[idx], v0=v[idx],
+                    external_force=external[idx], stuck=self.stuck[idx], mass=self.mass[idx], h=self.tick,
+                    breakaway=None if group.stiction is None else group.stiction(y[idx]))
+                self.pressure_a[idx], self.pressure_b[idx] = forces.pressure_a, forces.pressure_b
+            else:
+                forces = group.chambers.tick(
+                    conductance=self.conductance[idx], y=y[idx], v0=v[idx], external_force=external[idx],
+                    stuck=self.stuck[idx], mass=self.mass[idx], h=self.tick, breakaway=group.breakaway)
+                state = group.chambers.state
+                self.pressure_a[idx], self.pressure_b[idx] = state.pressure_a, state.pressure_b
+                self.supply_now[idx] = state.supply_pressure
             force_a[idx], force_b[idx] = forces.cylinder_a, forces.cylinder_b
             self.stuck[idx] = forces.stuck
-            self.pressure_a[idx], self.pressure_b[idx] = forces.pressure_a, forces.pressure_b
         return force_a, force_b
+
+
+class _PlantGroup:
+    """The scenarios ``idx`` that share one plant: its valves and, as-built, its chambers,
+    static-friction map and Hall reading (None where the plant does not have the effect)."""
+
+    def __init__(self, preset: Plant, idx: np.ndarray, *, tick: float, stroke: tuple[float, float],
+                 supply: np.ndarray):
+        params = preset.params
+        self.preset, self.idx = preset, idx
+        self.valves = ValveBank(params=params.valves, model=preset.valve_model, n=len(idx), tick=tick)
+        self.stiction = (StictionMap(params.stiction_map, params.friction.stiction, stroke)
+                         if params.stiction_map.scatter > 0 else None)
+        self.hall = (HallReading(params.hall, params.gears.spur_radius)
+                     if params.hall.calibration_error else None)
+        self.chambers = None
+        if params.chambers.compressible:
+            self.chambers = CompressibleCircuit(
+                chambers=params.chambers, line=params.supply_line, friction_params=params.friction,
+                bore_area=params.cylinder.bore_area, stroke=stroke, supply=supply,
+                initial_pressure=params.chambers.initial_pressure_fraction * supply)
+
+    def breakaway(self, y: np.ndarray) -> np.ndarray:
+        """Static friction (N) at rack positions ``y``."""
+        return self.stiction(y) if self.stiction is not None else np.full_like(y, self.preset.params.friction.stiction)

@@ -16,3 +16,5 @@ THESIS_EXPERIMENT_RMSE_DEG = {
     "ffpva": {1: (1.40, 0.06), 2: (2.08, 0.21), 3: (2.09, 0.12), 4: (1.95, 0.16)},
     "smc": {1: (1.19, 0.11), 2: (1.55, 0.25), 3: (1.69, 0.09), 4: (1.82, 0.17)},
 }
+# Experiment T1 steady-state error range (+-, deg) over the 5 runs (§8).
+THESIS_EXPERIMENT_SSE_T1_RANGE_DEG = {"pva": 0.41, "ffpva": 0.77, "smc": 0.85}

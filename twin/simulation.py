@@ -139,7 +139,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     failures: dict[int, str] = {}
     active = np.flatnonzero(lengths > 1)  # scenario i is stepped at ticks 0 .. lengths[i] - 2
     ends = {int(length) for length in lengths}
-    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "fs", "fa", "fb")}
+    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps", "fs", "fa", "fb")}
     valve_open = np.zeros((n, ticks, 4), dtype=bool)
     for k in range(ticks):
         y = qpos[:, dof.rack_a_dof].copy()
@@ -156,6 +156,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         rec["duty"][:, k] = duty
         rec["pa"][:, k] = plant.pressure_a
         rec["pb"][:, k] = plant.pressure_b
+        rec["ps"][:, k] = plant.supply_now
         valve_open[:, k] = plant.conductance > 0
         if k + 1 in ends:
             active = active[lengths[active] > k + 1]
@@ -186,13 +187,14 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         trace = Trace(
             time=t[:T], desired_angle=desired, angle=theta, rack_position=rec["y"][i, :T],
             measured_position=rec["ym"][i, :T], duty=rec["duty"][i, :T], valve_open=valve_open[i, :T],
-            pressure_a=rec["pa"][i, :T], pressure_b=rec["pb"][i, :T], supply_pressure=np.full(T, plant.supply[i]),
+            pressure_a=rec["pa"][i, :T], pressure_b=rec["pb"][i, :T], supply_pressure=rec["ps"][i, :T],
             coupling_error=theta - rec["y"][i, :T] / spur_radius[i],
             tooth_force_spur=rec["fs"][i, :T], tooth_force_rack_a=rec["fa"][i, :T],
             tooth_force_rack_b=rec["fb"][i, :T],
         )
         tr_i = trajectories[i]
-        metrics = tracking_metrics(desired, theta, ends_at_rest=tr_i.ends_at_rest,
+        scored = rec["ym"][i, :T] / spur_radius[i] if plants[i].metrics_on_sensor else theta
+        metrics = tracking_metrics(desired, scored, ends_at_rest=tr_i.ends_at_rest,
                                    rest_end_ticks=[int(round(e / h)) - 1 for e in tr_i.rest_ends()])
         results.append(Result(scenario=s, trace=trace, metrics=metrics, warnings=warnings, wall_time=wall))
     return results

@@ -49,11 +49,15 @@ class Rebuild:
 
 def _number(message: dict, field: str, low: float, high: float, unit: str) -> float:
     value = message.get(field)
-    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
-        raise BadMessage(f"{message['type']}: {field} must be a number, got {value!r}")
-    if not low <= value <= high:
-        raise BadMessage(f"{message['type']}: {field} must be in [{low:g}, {high:g}] {unit}, got {value:g}")
-    return float(value)
+    try:
+        number = float(value) if isinstance(value, int | float) and not isinstance(value, bool) else math.nan
+    except OverflowError:  # an integer too large for a float
+        number = math.inf
+    if math.isnan(number):
+        raise BadMessage(f"{message['type']}: {field} must be a number, got {str(value)[:40]!r}")
+    if not low <= number <= high:
+        raise BadMessage(f"{message['type']}: {field} must be in [{low:g}, {high:g}] {unit}, got {str(value)[:40]}")
+    return number
 
 
 def _choice(message: dict, field: str, choices) -> str:
@@ -65,8 +69,9 @@ def _choice(message: dict, field: str, choices) -> str:
 
 def parse(text: str | bytes) -> Target | PlayTrajectory | SwitchController | Rebuild:
     """The checked command in one message from the page."""
-    if len(text) > MAX_MESSAGE_BYTES:
-        raise BadMessage(f"message too long ({len(text)} bytes, at most {MAX_MESSAGE_BYTES})")
+    size = len(text.encode("utf-8")) if isinstance(text, str) else len(text)
+    if size > MAX_MESSAGE_BYTES:
+        raise BadMessage(f"message too long ({size} bytes, at most {MAX_MESSAGE_BYTES})")
     try:
         message = json.loads(text)
     except (ValueError, UnicodeDecodeError):

@@ -20,10 +20,13 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
+import os
 import pathlib
+import sys
 import time
 from collections.abc import Callable
 
+import mujoco
 import numpy as np
 import tornado.httpserver
 import tornado.ioloop
@@ -34,7 +37,7 @@ import umsgpack
 from meshcat.commands import Delete
 from meshcat.path import Path
 
-from twin.exceptions import TwinError
+from twin.exceptions import SimulationFailed, TwinError
 from twin.live import LiveJoint
 from twin.scenario import Scenario
 from viz import live_messages
@@ -42,7 +45,9 @@ from viz.recording import FPS, MESHCAT_SCRIPT, TraceRows, title_of, write_page
 from viz.scene import Frame, JointScene, frame_commands
 
 FRAME_RATE = 30.0  # pictures per second of wall time
-MAX_STEP_PER_FRAME = 0.1  # s of simulated time per picture, at most
+MAX_LAG_FRAMES = 3.0  # a late picture catches up at most this many frames of simulated time
+MAX_MESSAGE_BYTES = 4096  # tornado refuses larger WebSocket messages before they are read
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
 MAX_RECORDED_FRAMES = 10 * 60 * FPS  # a --html recording keeps the last 10 minutes
 PAGE = pathlib.Path(__file__).with_name("live_page.html")
 
@@ -104,10 +109,20 @@ class LiveSession:
                                              r.pressure_b, r.supply_pressure))
 
     def advance(self, duration: float) -> None:
-        for _ in range(int(duration / self.joint.tick + 1e-9)):
+        """Step ``duration`` seconds; the fraction of a tick left over is carried to the next call.
+        Raises SimulationFailed on a MuJoCo warning or a non-finite state."""
+        self._debt = getattr(self, "_debt", 0.0) + duration
+        ticks = int(self._debt / self.joint.tick + 1e-9)
+        self._debt -= ticks * self.joint.tick
+        for _ in range(ticks):
             self.joint.step()
             if self.joint.steps % self.record_every == 0:
                 self._capture()
+        data = self.joint.data
+        warned = [mujoco.mjtWarning(i).name for i, w in enumerate(data.warning) if w.number > 0]
+        if warned or not np.all(np.isfinite(data.qpos)):
+            raise SimulationFailed(f"MuJoCo {', '.join(warned) or 'state not finite'} at "
+                                   f"t = {self.joint.time:.3f} s")
 
     def handle(self, text: str | bytes) -> bool:
         """Apply one message from the page; True if the model was rebuilt. Raises BadMessage."""
@@ -137,8 +152,11 @@ class LiveSession:
                 "payload_g": s.payload * 1e3, "orientation": s.orientation.value, "plant": s.plant_name}
 
     def write_html(self, path: pathlib.Path) -> None:
-        write_page(path, scene=self.scene, frames=self.recorder.frames, rows=self.recorder.trace_rows(),
+        """The current model's run as a recording, written whole (a temporary file, then renamed)."""
+        tmp = path.with_name(path.name + ".tmp")
+        write_page(tmp, scene=self.scene, frames=self.recorder.frames, rows=self.recorder.trace_rows(),
                    title=f"live: {title_of(self.scenario)}")
+        os.replace(tmp, path)
 
 
 def _packed(commands: list[dict]) -> list[bytes]:
@@ -155,8 +173,22 @@ def _send(client: tornado.websocket.WebSocketHandler, message: bytes | str) -> b
     return True
 
 
+def _host_allowed(handler: tornado.web.RequestHandler, viewer: LiveViewer) -> bool:
+    """Bound to loopback, answer only requests addressed to loopback (no DNS rebinding)."""
+    if viewer.host not in ("127.0.0.1", "::1", "localhost"):
+        return True
+    host = handler.request.host.rsplit(":", 1)[0] if not handler.request.host.startswith("[") \
+        else handler.request.host.split("]")[0] + "]"
+    return host in LOOPBACK_HOSTS
+
+
 class _PageHandler(tornado.web.RequestHandler):
+    def initialize(self, viewer: LiveViewer) -> None:
+        self.viewer = viewer
+
     def get(self) -> None:
+        if not _host_allowed(self, self.viewer):
+            raise tornado.web.HTTPError(403)
         self.set_header("Content-Type", "text/html; charset=utf-8")
         self.write(PAGE.read_text())
 
@@ -170,6 +202,11 @@ class _ScriptHandler(tornado.web.RequestHandler):
 class _SocketHandler(tornado.websocket.WebSocketHandler):
     def initialize(self, viewer: LiveViewer) -> None:
         self.viewer = viewer
+
+    def prepare(self):
+        if not _host_allowed(self, self.viewer):
+            raise tornado.web.HTTPError(403)
+        return super().prepare()
 
     def open(self) -> None:
         self.viewer.clients.add(self)
@@ -191,9 +228,10 @@ class LiveViewer:
         self.session, self.speed, self.on_frame = session, speed, on_frame
         self.clients: set[_SocketHandler] = set()
         app = tornado.web.Application([
-            (r"/", _PageHandler), (r"/meshcat.js", _ScriptHandler),
+            (r"/", _PageHandler, {"viewer": self}), (r"/meshcat.js", _ScriptHandler),
             (r"/ws", _SocketHandler, {"viewer": self}),
-        ], log_function=lambda handler: None)
+        ], log_function=lambda handler: None, websocket_max_message_size=MAX_MESSAGE_BYTES)
+        self.failure: str | None = None
         try:
             self.sockets = tornado.netutil.bind_sockets(port, address=host)
         except OSError as error:
@@ -222,6 +260,9 @@ class LiveViewer:
         except TwinError as error:  # a valid message the twin cannot run (e.g. a rejected model)
             _send(client, json.dumps({"type": "error", "message": str(error)}))
             return
+        except Exception as error:  # noqa: BLE001 - answer, never drop the page's connection
+            _send(client, json.dumps({"type": "error", "message": f"cannot apply that: {type(error).__name__}"}))
+            return
         if rebuilt:
             self.broadcast(_packed(self.session.setup_commands()))
         self.broadcast([json.dumps(self.session.state())])
@@ -229,7 +270,14 @@ class LiveViewer:
     def _tick(self) -> None:
         now = time.perf_counter()
         elapsed, self._last = now - self._last, now
-        self.session.advance(min(elapsed * self.speed, MAX_STEP_PER_FRAME))
+        try:
+            self.session.advance(min(elapsed, MAX_LAG_FRAMES / FRAME_RATE) * self.speed)
+        except Exception as error:  # noqa: BLE001 - stop once, tell the page and the terminal
+            self.clock.stop()
+            self.failure = f"simulation stopped: {error}"
+            print(f"twin view: {self.failure}", file=sys.stderr, flush=True)
+            self.broadcast([json.dumps({"type": "error", "message": self.failure})])
+            return
         if self.clients:
             self.broadcast([*_packed(frame_commands(self.session.frame())), json.dumps(self.session.readout())])
         if self.on_frame is not None:

@@ -37,7 +37,6 @@ from viz.gear_mesh import gear_mesh, rack_mesh
 
 ROOT = "/twin"
 SCALE = 10.0  # the scene is drawn this many times its size
-RACK_LENGTH = 24e-3  # m, drawn length of the toothed part
 RACK_BAR_HEIGHT = 0.6e-3  # m, bar under the rack teeth
 VALVE_RADIUS = 1.2e-3  # m
 VALVES = ("v1", "v2", "v3", "v4")  # V1 supplies A, V2 discharges A, V3 supplies B, V4 discharges B (§4)
@@ -52,6 +51,7 @@ LOW_PRESSURE_RGB = np.array([0.15, 0.35, 0.75])
 HIGH_PRESSURE_RGB = np.array([0.85, 0.1, 0.1])
 CHAMBERS = {"a": ("cylinder_a_barrel", "rack_a_rod"), "b": ("cylinder_b_barrel", "rack_b_rod")}
 GHOST_RGBA = (0.9, 0.9, 0.95, 0.35)
+GHOST_LIFT = 1.2e-3  # m along the shaft
 GRAVITY_ARROW_LENGTH = 12e-3  # m
 GRAVITY_ARROW_BASE = np.array([0.03, 0.02, 0.0])  # m, in the world, beside the joint
 SCENE_CENTRE = np.array([-0.01, 0.0, 0.0])  # m, mid-way between the valves and the swept link
@@ -124,10 +124,12 @@ class JointScene:
             geometry, offset = self._geometry(geom)
             commands.append(SetObject(geometry, _material(rgba), path).lower())
             commands.append(SetTransform(offset, path).lower())
-            if body == "link":
+            if body == "link":  # the ghost floats just above the link so the two never z-fight
                 ghost = Path(("twin", "ghost", self.model.geom(geom).name))
+                lifted = offset.copy()
+                lifted[2, 3] += GHOST_LIFT
                 commands.append(SetObject(geometry, _material(GHOST_RGBA), ghost).lower())
-                commands.append(SetTransform(offset, ghost).lower())
+                commands.append(SetTransform(lifted, ghost).lower())
         for name, (barrel, _) in CHAMBERS.items():
             radius = 1.1 * float(self.model.geom_size[self.model.geom(barrel).id][0])
             commands.append(SetObject(g.Cylinder(1.0, radius), _material((*LOW_PRESSURE_RGB, 0.85)),
@@ -163,9 +165,14 @@ class JointScene:
             return _mesh(gear_mesh(gears.spur_teeth, module, 2 * size[1])), _homogeneous(rotation @ turn, position)
         if name in ("rack_a_bar", "rack_b_bar"):
             # Teeth toward the pinion, pitch line on the pinion's pitch circle (the body's origin).
-            facing = np.diag([1.0, -1.0, -1.0]) if position[1] > 0 else np.eye(3)
-            mesh = rack_mesh(RACK_LENGTH, module, 2 * size[2], RACK_BAR_HEIGHT)
-            return _mesh(mesh), _homogeneous(facing, np.array([position[0], 0.0, 0.0]))
+            above = position[1] > 0
+            facing = np.diag([1.0, -1.0, -1.0]) if above else np.eye(3)
+            joint = m.body_jntadr[m.geom_bodyid[geom]]
+            length, shift = rack_teeth_layout(
+                travel=tuple(m.jnt_range[joint]), teeth=gears.pinion_teeth, pinion_radius=gears.pinion_radius,
+                module=module, contact_angle=np.pi / 2 if above else -np.pi / 2)
+            mesh = rack_mesh(length, module, 2 * size[2], RACK_BAR_HEIGHT)
+            return _mesh(mesh), _homogeneous(facing, np.array([shift, 0.0, 0.0]))
         kind = m.geom_type[geom]
         if kind == mujoco.mjtGeom.mjGEOM_BOX:
             return g.Box(list(2 * size)), _homogeneous(rotation, position)
@@ -241,6 +248,22 @@ class JointScene:
         piston = data.geom_xpos[r] - data.geom_xmat[r].reshape(3, 3)[:, 2] * self.model.geom_size[r][1]
         length = max(float(np.dot(piston - closed_end, axis)), 0.5e-3)
         return _homogeneous(barrel_axes @ _Y_TO_Z, closed_end + axis * length / 2, scale=(1.0, length, 1.0))
+
+
+def rack_teeth_layout(*, travel: tuple[float, float], teeth: int, pinion_radius: float, module: float,
+                      contact_angle: float) -> tuple[float, float]:
+    """Length (m) of a rack's toothed part and where its centre sits in the rack's frame (m), so
+    that its teeth cover the pinion's contact point over the rack joint's whole ``travel`` (m)
+    and, at zero travel, a tooth fills the pinion's gap nearest the contact (tooth 0 of the
+    pinion on +x, the contact at ``contact_angle`` rad on the pitch circle)."""
+    pitch = np.pi * module
+    low, high = -travel[1], -travel[0]  # the contact point's x in the rack's frame
+    count = int(np.ceil((high - low) / pitch)) + 4  # two spare teeth at each end
+    gap = (np.round(contact_angle / (2 * np.pi / teeth) - 0.5) + 0.5) * 2 * np.pi / teeth
+    tooth_x = -pinion_radius * (gap - contact_angle) * np.sin(contact_angle)  # along the pitch line
+    first = tooth_x - np.ceil((tooth_x - (low + high) / 2) / pitch) * pitch  # a tooth near the middle
+    centre = first - (0.0 if count % 2 else pitch / 2)  # rack_mesh centres its teeth on its middle
+    return count * pitch, float(centre)
 
 
 def _mesh(mesh) -> g.TriangularMeshGeometry:

@@ -1,0 +1,90 @@
+"""``twin calibrate``: its cost, its box, its determinism, and the committed preset it reproduces."""
+
+from __future__ import annotations
+
+import json
+import math
+
+import pytest
+
+from twin import calibrate
+from twin.as_built import CALIBRATION_FILE, FITTED, as_built_plant, calibrated_values
+from twin.calibrate import CellResult, cost, values_at
+from twin.exceptions import InvalidScenario
+from twin.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG
+
+
+def exact_cells(scale: dict | None = None) -> list[CellResult]:
+    """Cells that hit the experimental table, RMSE times ``scale[(controller, T)]``."""
+    scale = scale or {}
+    cells = []
+    for controller, trajectory in calibrate.CELLS:
+        target = THESIS_EXPERIMENT_RMSE_DEG[controller][trajectory][0] * scale.get((controller, trajectory), 1.0)
+        sse = THESIS_EXPERIMENT_SSE_T1_RANGE_DEG[controller] if trajectory == 1 else math.nan
+        cells.append(CellResult(controller, trajectory, (target, target), (sse, -sse / 2), 0))
+    return cells
+
+
+def test_cost_is_zero_on_the_table_and_log_ratio_squared_off_it():
+    assert cost(exact_cells()) == pytest.approx(0.0, abs=1e-12)
+    assert cost(exact_cells({("smc", 3): 2.0})) == pytest.approx(math.log(2.0) ** 2)
+    assert cost(exact_cells({("pva", 2): 0.5})) == pytest.approx(math.log(2.0) ** 2)
+
+
+def test_cost_weighs_the_t1_steady_error_range():
+    cells = exact_cells()
+    ffpva_t1 = next(i for i, c in enumerate(cells) if (c.controller, c.trajectory) == ("ffpva", 1))
+    doubled = 2 * THESIS_EXPERIMENT_SSE_T1_RANGE_DEG["ffpva"]
+    cells[ffpva_t1] = CellResult("ffpva", 1, cells[ffpva_t1].rmse_deg, (0.1, -doubled), 0)
+    assert cost(cells) == pytest.approx(calibrate.SSE_WEIGHT * math.log(2.0) ** 2)
+
+
+def test_a_failed_run_costs():
+    cells = exact_cells()
+    cells[0] = CellResult(cells[0].controller, cells[0].trajectory, cells[0].rmse_deg, cells[0].sse_deg, 1)
+    assert cost(cells) == pytest.approx(1.0)
+
+
+def test_unit_box_maps_onto_the_plausible_bounds():
+    assert values_at([0.0] * len(FITTED)) == {f.name: f.low for f in FITTED}
+    assert values_at([1.0] * len(FITTED)) == {f.name: f.high for f in FITTED}
+    assert values_at([2.0, -1.0, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
+
+
+def test_committed_preset_is_inside_its_bounds_and_is_the_as_built_plant():
+    values = calibrated_values()
+    for f in FITTED:
+        assert f.low <= values[f.name] <= f.high
+    plant = as_built_plant()
+    assert plant.params.friction.stiction == values["stiction"]
+    assert plant.params.valves.dead_zone_duty == values["dead_zone_duty"]
+    assert plant.params.chambers.air_fraction == values["air_fraction"]
+    assert plant.params.friction.ccw_coulomb_scale == values["ccw_coulomb_scale"]
+
+
+def test_a_value_outside_its_bounds_is_refused(tmp_path):
+    record = json.loads(CALIBRATION_FILE.read_text())
+    record["fitted"]["air_fraction"] = 0.5
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(record))
+    with pytest.raises(InvalidScenario, match="air_fraction = 0.5 is outside"):
+        calibrated_values(path)
+
+
+def test_same_seeds_same_fit_whatever_the_workers():
+    small = dict(max_evaluations=2, fit_seeds=(0,), check_seeds=(0,))
+    one = calibrate.calibrate(workers=1, **small)
+    two = calibrate.calibrate(workers=2, **small)
+    assert one.values == two.values and one.cost == two.cost
+    assert [c.rmse_deg for c in one.check_cells] == [c.rmse_deg for c in two.check_cells]
+
+
+def test_calibrate_retraces_the_committed_fit():
+    """The same seeds give the same numbers: the fit's first evaluations (the fixed starting simplex) cost
+    exactly what the committed file says. The whole fit (100 evaluations, ~6 min on 2 cores) is
+    ``twin calibrate --out DIR``; its file equals the committed one (see README, as-built)."""
+    committed = json.loads(CALIBRATION_FILE.read_text())
+    result = calibrate.calibrate(workers=2, max_evaluations=3)
+    for (values, cost_now), expected in zip(result.history, committed["history"][:3], strict=True):
+        assert {k: round(v, 6) for k, v in values.items()} == expected["values"]
+        assert round(cost_now, 6) == expected["cost"]

@@ -1,0 +1,221 @@
+"""``twin calibrate``: fit the as-built parameters the thesis does not give to
+its experimental Chapter 5 table (SPEC §8).
+
+Targets: the mean RMSE of every experimental cell (PVA T1-T3, FF + PVA T1-T4,
+sliding mode T1-T4), horizontal, no payload, and the T1 steady-error range of
+each controller. Cost::
+
+    sum over cells of ln(RMSE_twin / RMSE_exp)^2
+    + SSE_WEIGHT * sum over controllers of ln(range_twin / range_exp)^2
+
+with RMSE_twin the mean over the ensemble's noise seeds and range_twin the
+largest |SSE| of T1 among them (the thesis's "+-"). Each fitted parameter is
+searched inside its plausible bounds (:data:`twin.as_built.FITTED`) through a
+unit coordinate u in [0, 1]; the optimiser is scipy's Nelder-Mead from the
+middle of the box, deterministic, so the same seeds give the same preset.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import json
+import math
+import multiprocessing
+import pathlib
+import time
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from twin.as_built import ASSUMED, FITTED, as_built_plant
+from twin.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG
+from twin.scenario import Scenario
+from twin.sweep import code_version
+
+CELLS = tuple((c, t) for c, row in THESIS_EXPERIMENT_RMSE_DEG.items() for t in row)
+SSE_WEIGHT = 0.25
+FIT_SEEDS = (0, 1, 2)  # noise seeds of the ensemble the fit sees
+CHECK_SEEDS = (0, 1, 2, 3, 4)  # the thesis's five runs, for the residual table
+MAX_EVALUATIONS = 100
+FILE_VERSION = 1
+
+
+@dataclasses.dataclass(frozen=True)
+class CellResult:
+    controller: str
+    trajectory: int
+    rmse_deg: tuple[float, ...]  # per seed
+    sse_deg: tuple[float, ...]  # per seed (nan when the trajectory ends moving)
+    failed: int  # runs with warnings
+
+    @property
+    def mean_rmse(self) -> float:
+        return float(np.mean(self.rmse_deg))
+
+    @property
+    def sse_range(self) -> float:
+        return float(np.nanmax(np.abs(self.sse_deg))) if not all(math.isnan(s) for s in self.sse_deg) else math.nan
+
+
+def values_at(u: Sequence[float]) -> dict[str, float]:
+    """Parameter values at unit coordinates ``u`` (clipped into the box)."""
+    return {f.name: f.low + float(np.clip(x, 0.0, 1.0)) * (f.high - f.low) for f, x in zip(FITTED, u, strict=True)}
+
+
+def _run_cells(values: dict[str, float], jobs: list[tuple[str, int, int]]) -> list[tuple]:
+    from twin.runner import run_many
+
+    plant = as_built_plant(values, name="as-built-fit")
+    results = run_many([Scenario(c, t, plant=plant, seed=s) for c, t, s in jobs], nthread=1)
+    return [(r.scenario.controller, r.scenario.trajectory, math.degrees(r.metrics.rmse), math.degrees(r.metrics.sse),
+             bool(r.warnings)) for r in results]
+
+
+class Evaluator:
+    """Runs the experimental cells for parameter values over ``seeds``, on ``workers`` processes."""
+
+    def __init__(self, *, seeds: Sequence[int], workers: int):
+        self.seeds, self.workers = tuple(seeds), workers
+        self.pool = (concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"))
+                     if workers > 1 else None)
+
+    def close(self) -> None:
+        if self.pool is not None:
+            self.pool.shutdown()
+
+    def cells(self, values: dict[str, float]) -> list[CellResult]:
+        jobs = [(c, t, s) for c, t in CELLS for s in self.seeds]
+        # Interleave by trajectory so every worker gets a like mix of long and short runs.
+        shares = [jobs[i::self.workers] for i in range(self.workers)]
+        if self.pool is None:
+            rows = _run_cells(values, jobs)
+        else:
+            rows = [row for part in self.pool.map(_run_cells, [values] * len(shares), shares) for row in part]
+        found: dict[tuple[str, int], list] = {}
+        for controller, trajectory, rmse, sse, failed in rows:
+            found.setdefault((controller, trajectory), []).append((rmse, sse, failed))
+        return [CellResult(c, t, tuple(r for r, _, _ in found[c, t]), tuple(s for _, s, _ in found[c, t]),
+                           sum(f for _, _, f in found[c, t])) for c, t in CELLS]
+
+
+def cost(cells: Sequence[CellResult]) -> float:
+    """The fit's cost (see the module docstring); a failed run costs as a factor-e miss."""
+    total = 0.0
+    for cell in cells:
+        target = THESIS_EXPERIMENT_RMSE_DEG[cell.controller][cell.trajectory][0]
+        total += math.log(max(cell.mean_rmse, 1e-6) / target) ** 2 + cell.failed
+        if cell.trajectory == 1:
+            expected = THESIS_EXPERIMENT_SSE_T1_RANGE_DEG[cell.controller]
+            total += SSE_WEIGHT * math.log(max(cell.sse_range, 1e-3) / expected) ** 2
+    return total
+
+
+@dataclasses.dataclass
+class Calibration:
+    values: dict[str, float]
+    cost: float
+    evaluations: int
+    history: list[tuple[dict[str, float], float]]
+    fit_cells: list[CellResult]
+    check_cells: list[CellResult]
+    wall_time: float
+
+
+def calibrate(*, workers: int = 2, max_evaluations: int = MAX_EVALUATIONS, fit_seeds: Sequence[int] = FIT_SEEDS,
+              check_seeds: Sequence[int] = CHECK_SEEDS,
+              progress: Callable[[int, float, dict], None] | None = None) -> Calibration:
+    """Fit :data:`twin.as_built.FITTED` (see the module docstring)."""
+    from scipy.optimize import minimize
+
+    started = time.perf_counter()
+    history: list[tuple[dict[str, float], float]] = []
+    seen: dict[tuple[float, ...], tuple[float, list[CellResult]]] = {}
+    evaluator = Evaluator(seeds=fit_seeds, workers=workers)
+
+    def objective(u: np.ndarray) -> float:
+        key = tuple(float(np.clip(x, 0.0, 1.0)) for x in u)
+        if key not in seen:
+            values = values_at(key)
+            cells = evaluator.cells(values)
+            seen[key] = (cost(cells), cells)
+            history.append((values, seen[key][0]))
+            if progress is not None:
+                progress(len(history), seen[key][0], values)
+        return seen[key][0]
+
+    try:
+        start = np.full(len(FITTED), 0.5)
+        simplex = np.vstack([start] + [start + 0.25 * np.eye(len(FITTED))[i] for i in range(len(FITTED))])
+        minimize(objective, start, method="Nelder-Mead",
+                 options={"initial_simplex": simplex, "maxfev": max_evaluations, "xatol": 0.02, "fatol": 1e-3})
+        best_key = min(seen, key=lambda k: seen[k][0])
+        best = values_at(best_key)
+        check = Evaluator(seeds=check_seeds, workers=workers)
+        try:
+            check_cells = check.cells(best)
+        finally:
+            check.close()
+    finally:
+        evaluator.close()
+    return Calibration(values=best, cost=seen[best_key][0], evaluations=len(history), history=history,
+                       fit_cells=seen[best_key][1], check_cells=check_cells,
+                       wall_time=time.perf_counter() - started)
+
+
+def _cell_rows(cells: Sequence[CellResult]) -> list[dict]:
+    rows = []
+    for cell in cells:
+        target, spread = THESIS_EXPERIMENT_RMSE_DEG[cell.controller][cell.trajectory]
+        rows.append({"controller": cell.controller, "trajectory": cell.trajectory,
+                     "experiment_rmse_deg": target, "experiment_std_deg": spread,
+                     "twin_rmse_deg": round(cell.mean_rmse, 4), "twin_std_deg": round(float(np.std(cell.rmse_deg)), 4),
+                     "ratio": round(cell.mean_rmse / target, 4),
+                     "twin_sse_range_deg": None if math.isnan(cell.sse_range) else round(cell.sse_range, 4),
+                     "experiment_sse_range_deg": THESIS_EXPERIMENT_SSE_T1_RANGE_DEG.get(cell.controller)
+                     if cell.trajectory == 1 else None,
+                     "failed_runs": cell.failed})
+    return rows
+
+
+def record(result: Calibration, *, max_evaluations: int, fit_seeds: Sequence[int],
+           check_seeds: Sequence[int]) -> dict:
+    """The versioned data file's content."""
+    return {
+        "version": FILE_VERSION,
+        "code_version": code_version(),
+        "made_by": f"twin calibrate (Nelder-Mead, at most {max_evaluations} evaluations, fit seeds "
+                   f"{list(fit_seeds)})",
+        "fitted": {name: round(value, 6) for name, value in result.values.items()},
+        "bounds": {f.name: {"low": f.low, "high": f.high, "unit": f.unit, "why": f.why} for f in FITTED},
+        "assumed": ASSUMED,
+        "cost": round(result.cost, 6),
+        "evaluations": result.evaluations,
+        "wall_time_s": round(result.wall_time, 1),
+        "residuals_fit_seeds": _cell_rows(result.fit_cells),
+        "residuals_check_seeds": _cell_rows(result.check_cells),
+        "check_seeds": list(check_seeds),
+        "history": [{"values": {k: round(v, 6) for k, v in values.items()}, "cost": round(c, 6)}
+                    for values, c in result.history],
+    }
+
+
+def write(data: dict, out: pathlib.Path) -> pathlib.Path:
+    path = out / "as_built.json"
+    tmp = path.with_suffix(".json.tmp")
+    tmp.write_text(json.dumps(data, indent=1) + "\n")
+    tmp.replace(path)
+    return path
+
+
+def format_residuals(data: dict) -> str:
+    """The check-seed residual table as text."""
+    lines = [f"{'controller':10} {'T':>2} {'experiment':>12} {'twin':>12} {'twin/exp':>8} {'SSE range exp/twin':>19}"]
+    for r in data["residuals_check_seeds"]:
+        sse = (f"{r['experiment_sse_range_deg']:.2f} / {r['twin_sse_range_deg']:.2f}"
+               if r["experiment_sse_range_deg"] is not None else "")
+        lines.append(f"{r['controller']:10} {r['trajectory']:>2} {r['experiment_rmse_deg']:6.2f} ± {r['experiment_std_deg']:.2f}"
+                     f" {r['twin_rmse_deg']:6.2f} ± {r['twin_std_deg']:.2f} {r['ratio']:8.2f} {sse:>19}")
+    fitted = ", ".join(f"{k} = {v:g}" for k, v in data["fitted"].items())
+    lines.append(f"fitted: {fitted}; cost {data['cost']:.4f}")
+    return "\n".join(lines)

@@ -1,0 +1,77 @@
+"""Plots of ``twin study``: RMSE against payload (robustness) and the open-loop responses."""
+
+from __future__ import annotations
+
+import math
+import pathlib
+from collections.abc import Sequence
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+from twin.demo import LABELS  # noqa: E402
+from twin.plants import plant  # noqa: E402
+from twin.studies import SOFT_LIMITS, OpenLoopStudy  # noqa: E402
+
+ORIENTATION_STYLES = {"horizontal": "-", "vertical": "--"}
+
+
+def plot_robustness(summary: Sequence[dict], path: pathlib.Path) -> None:
+    """RMSE (mean, std error bars) against tip payload; one panel per trajectory, a line per
+    controller x orientation (colour: controller, line style: orientation)."""
+    trajectories = sorted({s["trajectory"] for s in summary})
+    fig, axes = plt.subplots(1, len(trajectories), figsize=(5.5 * len(trajectories), 4.5), squeeze=False,
+                             sharey=True, constrained_layout=True)
+    controllers = sorted({s["controller"] for s in summary})
+    for ax, trajectory in zip(axes[0], trajectories, strict=True):
+        for c_index, controller in enumerate(controllers):
+            for orientation, style in ORIENTATION_STYLES.items():
+                members = sorted((s for s in summary if (s["trajectory"], s["controller"], s["orientation"])
+                                  == (trajectory, controller, orientation)), key=lambda s: s["payload_g"])
+                if not members:
+                    continue
+                mean = [np.nan if s["rmse_mean_deg"] is None else s["rmse_mean_deg"] for s in members]
+                std = [np.nan if s["rmse_std_deg"] is None else s["rmse_std_deg"] for s in members]
+                x = [s["payload_g"] for s in members]
+                ax.plot(x, mean, ls=style, marker="o", color=f"C{c_index}", label=f"{LABELS[controller]}, {orientation}")
+                ax.errorbar(x, mean, yerr=std, fmt="none", ecolor=f"C{c_index}", capsize=3)
+        ax.set_title(f"T{trajectory} ({summary[0]['plant']} plant)")
+        ax.set_xlabel("payload at the link tip (g)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, handlelength=3.5)  # long enough to show the dashes
+    axes[0][0].set_ylabel("RMSE (deg), mean ± std over seeds")
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
+
+
+def plot_openloop(study: OpenLoopStudy, path: pathlib.Path) -> None:
+    """Angle and duty against time for both plants, soft limits dotted, each reversal of the commanded
+    duty marked, so the lag between the plants at each reversal shows."""
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(9, 6.5), sharex=True, height_ratios=(2, 1),
+                                      constrained_layout=True)
+    for index, run in enumerate(study.runs):
+        color = f"C{index}"
+        top.plot(run.time, np.degrees(run.angle), color=color, label=f"{run.plant}")
+        bottom.step(run.time, run.duty, where="post", color=color, label=f"{run.plant}")
+        for r in run.reversals:
+            top.axvline(r.time, color=color, lw=0.6, ls=":")
+            if not math.isnan(r.lag):
+                top.annotate(f"{r.lag * 1e3:.0f} ms", (r.time + r.lag, np.degrees(np.interp(r.time + r.lag, run.time,
+                                                                                              run.angle))),
+                             xytext=(4, -12 if index else 6), textcoords="offset points", fontsize=7, color=color)
+    radius = plant(study.runs[0].plant).params.gears.spur_radius
+    for y in SOFT_LIMITS:
+        top.axhline(math.degrees(y / radius), color="0.5", ls="--", lw=0.8)
+    top.set_ylabel("output angle (deg)")
+    top.set_title("open-loop validation (SPEC §4.6); dotted: reversals of the duty's sign, "
+                  "dashed: soft limits; labels: lag", fontsize=9)
+    bottom.set_ylabel("duty (%)")
+    bottom.set_xlabel("time (s)")
+    for ax in (top, bottom):
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    fig.savefig(path, dpi=90)
+    plt.close(fig)
