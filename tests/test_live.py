@@ -327,3 +327,43 @@ def test_a_failing_simulation_stops_once_and_tells_the_page():
             sock.close()
     assert stopped == [True] and viewer.failure == "simulation stopped: boom"
     assert json.loads(sent[0]) == {"type": "error", "message": "simulation stopped: boom"}
+
+
+def test_rebuilds_are_rate_limited_and_state_says_what_plays():
+    session = LiveSession(Scenario("ffpva", 4, seed=0))
+    assert session.state()["playing"] == "T4"
+    session.handle('{"type": "target", "angle_deg": 100}')
+    assert session.state()["playing"] == "target 100 deg"
+    assert session.handle('{"type": "payload", "grams": 5}') is True
+    with pytest.raises(live_messages.BadMessage, match="wait 0.5 s"):
+        session.handle('{"type": "orientation", "value": "vertical"}')
+    assert session.scenario.orientation is Orientation.HORIZONTAL
+
+
+def test_a_page_that_has_not_taken_its_last_frame_gets_no_new_one():
+    session = LiveSession(Scenario("ffpva", 1, seed=0))
+    viewer = LiveViewer(session, port=0)
+    loop = asyncio.new_event_loop()
+    try:
+        class Page:
+            def __init__(self, done):
+                self.sent, self.done = [], done
+
+            def write_message(self, message, binary=False):
+                self.sent.append(message)
+                future = loop.create_future()
+                if self.done:
+                    future.set_result(None)
+                return future
+
+        slow, fast = Page(done=False), Page(done=True)
+        viewer.clients = {slow, fast}
+        for _ in range(3):
+            viewer.broadcast(["frame"], droppable=True)
+        viewer.broadcast(["state"])
+    finally:
+        for sock in viewer.sockets:
+            sock.close()
+        loop.close()
+    assert fast.sent == ["frame", "frame", "frame", "state"]
+    assert slow.sent == ["frame", "state"]  # frames dropped while its first one is in flight; state still sent

@@ -45,6 +45,7 @@ from viz.recording import FPS, MESHCAT_SCRIPT, TraceRows, title_of, write_page
 from viz.scene import Frame, JointScene, frame_commands
 
 FRAME_RATE = 30.0  # pictures per second of wall time
+MIN_REBUILD_INTERVAL = 0.5  # s between model rebuilds (each compiles the model on the server's thread)
 MAX_LAG_FRAMES = 3.0  # a late picture catches up at most this many frames of simulated time
 MAX_MESSAGE_BYTES = 4096  # tornado refuses larger WebSocket messages before they are read
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
@@ -81,6 +82,7 @@ class LiveSession:
 
     def __init__(self, scenario: Scenario, *, record: bool = False):
         self.record = record
+        self._rebuilt_at = -math.inf
         self._start(scenario)
 
     def _start(self, scenario: Scenario) -> None:
@@ -134,8 +136,13 @@ class LiveSession:
         elif isinstance(command, live_messages.SwitchController):
             self.joint.switch_controller(command.name)
         else:
+            now = time.monotonic()
+            if now - self._rebuilt_at < MIN_REBUILD_INTERVAL:
+                raise live_messages.BadMessage(f"the model was rebuilt {now - self._rebuilt_at:.1f} s ago: "
+                                               f"wait {MIN_REBUILD_INTERVAL:g} s between payload/orientation changes")
             changes = {k: v for k, v in dataclasses.asdict(command).items() if v is not None}
             self._start(dataclasses.replace(self.scenario, **changes))
+            self._rebuilt_at = now
             return True
         return False
 
@@ -147,8 +154,10 @@ class LiveSession:
                 "supply_kpa": r.supply_pressure / 1e3, "valves": list(r.valve_open)}
 
     def state(self) -> dict:
-        s = self.scenario
-        return {"type": "state", "controller": s.controller, "trajectory": s.trajectory,
+        s, plan = self.scenario, self.joint.plan
+        target = math.degrees(plan.start + sum(seg.delta for seg in plan.segments))
+        playing = f"T{plan.number}" if plan.number else f"target {target:.0f} deg"
+        return {"type": "state", "controller": s.controller, "trajectory": s.trajectory, "playing": playing,
                 "payload_g": s.payload * 1e3, "orientation": s.orientation.value, "plant": s.plant_name}
 
     def write_html(self, path: pathlib.Path) -> None:
@@ -163,14 +172,15 @@ def _packed(commands: list[dict]) -> list[bytes]:
     return [umsgpack.packb(c) for c in commands]
 
 
-def _send(client: tornado.websocket.WebSocketHandler, message: bytes | str) -> bool:
-    """Queue ``message`` to ``client``; False if it has gone (a page closed mid-write is not an error)."""
+def _send(client: tornado.websocket.WebSocketHandler, message: bytes | str):
+    """Queue ``message`` to ``client``: the write's future, or None if the page has gone (a page
+    closed mid-write is not an error)."""
     try:
         sent = client.write_message(message, binary=isinstance(message, bytes))
     except tornado.websocket.WebSocketClosedError:
-        return False
+        return None
     sent.add_done_callback(lambda future: future.exception())  # a late close: seen, and ignored
-    return True
+    return sent
 
 
 def _host_allowed(handler: tornado.web.RequestHandler, viewer: LiveViewer) -> bool:
@@ -244,12 +254,20 @@ class LiveViewer:
         host = f"[{self.host}]" if ":" in self.host else self.host
         return f"http://{host}:{self.port}/"
 
-    def broadcast(self, messages: list[bytes | str]) -> None:
+    def broadcast(self, messages: list[bytes | str], *, droppable: bool = False) -> None:
+        """Send ``messages`` to every page; ``droppable`` ones (a frame) skip a page that has not
+        yet taken the previous frame, so a stalled tab cannot pile up memory."""
         for client in list(self.clients):
+            pending = getattr(client, "pending_frame", None)
+            if droppable and pending is not None and not pending.done():
+                continue
             for message in messages:
-                if not _send(client, message):
+                sent = _send(client, message)
+                if sent is None:
                     self.clients.discard(client)
                     break
+                if droppable:
+                    client.pending_frame = sent
 
     def receive(self, client: _SocketHandler, message: str | bytes) -> None:
         try:
@@ -279,7 +297,8 @@ class LiveViewer:
             self.broadcast([json.dumps({"type": "error", "message": self.failure})])
             return
         if self.clients:
-            self.broadcast([*_packed(frame_commands(self.session.frame())), json.dumps(self.session.readout())])
+            self.broadcast([*_packed(frame_commands(self.session.frame())), json.dumps(self.session.readout())],
+                           droppable=True)
         if self.on_frame is not None:
             self.on_frame()
 
