@@ -115,9 +115,9 @@ def _u(seed: int, n: int) -> np.ndarray:
 
 
 def test_knots_span_stroke_at_spacing():
-    m = StictionMap(StictionMapParams(scatter=1.0, knot_spacing=1e-3), 3.6, STROKE)
+    m = StictionMap(StictionMapParams(scatter=1.0, knot_spacing=1e-3, seed=0), 3.6, STROKE)
     np.testing.assert_allclose(m.knots, np.arange(21) * 1e-3, atol=1e-15)
-    uneven = StictionMap(StictionMapParams(scatter=1.0, knot_spacing=1e-3), 3.6, (0.0, 2.5e-3))
+    uneven = StictionMap(StictionMapParams(scatter=1.0, knot_spacing=1e-3, seed=0), 3.6, (0.0, 2.5e-3))
     np.testing.assert_allclose(uneven.knots, [0.0, 1e-3, 2e-3, 2.5e-3], atol=1e-15)
 
 
@@ -139,7 +139,7 @@ def test_linear_between_knots_and_held_outside():
 
 
 def test_zero_scatter_is_base_exactly():
-    m = StictionMap(StictionMapParams(scatter=0.0), 3.6, STROKE)
+    m = StictionMap(StictionMapParams(scatter=0.0, seed=0), 3.6, STROKE)
     y = np.linspace(-5e-3, 25e-3, 31).reshape(1, 31)
     out = m(y)
     assert out.shape == y.shape
@@ -167,3 +167,17 @@ def test_same_seed_same_map_other_seed_different():
 def test_stiction_map_rejects_bad_arguments(base, stroke):
     with pytest.raises(InvalidParameter):
         StictionMap(StictionMapParams(scatter=1.0), base, stroke)
+
+
+def test_stiction_maps_evaluate_each_runs_own_map():
+    from twin.stiction_map import StictionMaps
+
+    params = StictionMapParams(scatter=1.0, knot_spacing=1e-3)
+    maps = StictionMaps(params, 2.0, STROKE, seeds=[(0, 1), (1, 1), (0, 1)])
+    y = np.array([3.3e-3, 3.3e-3, 7.75e-3])
+    own = [StictionMap(StictionMapParams(scatter=1.0, knot_spacing=1e-3, seed=s), 2.0, STROKE)(yi)
+           for s, yi in zip([(0, 1), (1, 1), (0, 1)], y, strict=True)]
+    np.testing.assert_allclose(maps(y), own, rtol=1e-12)
+    assert maps(y)[0] != maps(y)[1]  # two runs, two joints
+    with pytest.raises(InvalidParameter, match="needs a seed"):
+        StictionMap(params, 2.0, STROKE)

@@ -234,11 +234,11 @@ def test_a_joint_that_never_turns_has_no_lag():
     assert math.isnan(reversal.lag)
 
 
-def test_reversals_of_two_runs_pair_only_at_the_same_step():
-    a = [Reversal(0.384, -1, 0.006), Reversal(0.816, -1, 0.022)]
-    b = [Reversal(0.816, 1, 0.214), Reversal(1.408, 1, 0.4)]  # at 0.816 s the command turned the other way
+def test_reversals_of_two_runs_pair_only_at_the_same_step_and_direction():
+    a = [Reversal(0.384, -1, 0.006), Reversal(0.816, -1, 0.022), Reversal(1.2, 1, 0.01)]
+    b = [Reversal(0.816, 1, 0.214), Reversal(1.2, 1, 0.03), Reversal(1.408, 1, 0.4)]  # 0.816 s: the other way
     pairs = paired_reversals(a, b, window=0.008)
-    assert pairs == [(a[0], None), (a[1], b[0]), (None, b[1])]
+    assert pairs == [(a[0], None), (a[1], None), (None, b[0]), (a[2], b[1]), (None, b[2])]
 
 
 # --- CLI ------------------------------------------------------------------------------------------------------
@@ -254,8 +254,9 @@ def test_cli_openloop_writes_the_csv_and_the_figure(tmp_path):
     assert proc.returncode == 0, proc.stderr
     chosen = studies.default_plant("thesis-pwm")
     columns, rows = _rows(tmp_path / "ol" / "openloop.csv")
-    assert columns == ["t_s", "duty_thesis_pct", "angle_thesis_deg", f"duty_{chosen}_pct", f"angle_{chosen}_deg"]
-    assert len(rows) == 3000 and float(rows[0]["duty_thesis_pct"]) == 0.0
+    assert columns == ["t_s", "duty_thesis-deadzone_pct", "angle_thesis-deadzone_deg", f"duty_{chosen}_pct",
+                       f"angle_{chosen}_deg"]
+    assert len(rows) == 3000 and float(rows[0]["duty_thesis-deadzone_pct"]) == 0.0
     assert (tmp_path / "ol" / "openloop.png").read_bytes().startswith(PNG_MAGIC)
     assert "lag ms" in proc.stdout and f"{chosen}: mean lag" in proc.stdout
 

@@ -37,7 +37,7 @@ CELLS = tuple((c, t) for c, row in THESIS_EXPERIMENT_RMSE_DEG.items() for t in r
 SSE_WEIGHT = 0.25
 FIT_SEEDS = (0, 1, 2)  # noise seeds of the ensemble the fit sees
 CHECK_SEEDS = (0, 1, 2, 3, 4)  # the thesis's five runs, for the residual table
-MAX_EVALUATIONS = 100
+MAX_EVALUATIONS = 80
 FILE_VERSION = 1
 
 
@@ -68,8 +68,8 @@ def _run_cells(values: dict[str, float], jobs: list[tuple[str, int, int]]) -> li
 
     plant = as_built_plant(values, name="as-built-fit")
     results = run_many([Scenario(c, t, plant=plant, seed=s) for c, t, s in jobs], nthread=1)
-    return [(r.scenario.controller, r.scenario.trajectory, math.degrees(r.metrics.rmse), math.degrees(r.metrics.sse),
-             bool(r.warnings)) for r in results]
+    return [(r.scenario.controller, r.scenario.trajectory, r.scenario.seed, math.degrees(r.metrics.rmse),
+             math.degrees(r.metrics.sse), bool(r.warnings)) for r in results]
 
 
 class Evaluator:
@@ -87,13 +87,13 @@ class Evaluator:
     def cells(self, values: dict[str, float]) -> list[CellResult]:
         jobs = [(c, t, s) for c, t in CELLS for s in self.seeds]
         # Interleave by trajectory so every worker gets a like mix of long and short runs.
-        shares = [jobs[i::self.workers] for i in range(self.workers)]
+        shares = [share for share in (jobs[i::self.workers] for i in range(self.workers)) if share]
         if self.pool is None:
             rows = _run_cells(values, jobs)
         else:
             rows = [row for part in self.pool.map(_run_cells, [values] * len(shares), shares) for row in part]
         found: dict[tuple[str, int], list] = {}
-        for controller, trajectory, rmse, sse, failed in rows:
+        for controller, trajectory, _seed, rmse, sse, failed in sorted(rows, key=lambda row: row[:3]):
             found.setdefault((controller, trajectory), []).append((rmse, sse, failed))
         return [CellResult(c, t, tuple(r for r, _, _ in found[c, t]), tuple(s for _, s, _ in found[c, t]),
                            sum(f for _, _, f in found[c, t])) for c, t in CELLS]
@@ -186,16 +186,16 @@ def record(result: Calibration, *, max_evaluations: int, fit_seeds: Sequence[int
         "code_version": code_version(),
         "made_by": f"twin calibrate (Nelder-Mead, at most {max_evaluations} evaluations, fit seeds "
                    f"{list(fit_seeds)})",
-        "fitted": {name: round(value, 6) for name, value in result.values.items()},
+        "fitted": dict(result.values),  # full precision: the preset is exactly what was scored
         "bounds": {f.name: {"low": f.low, "high": f.high, "unit": f.unit, "why": f.why} for f in FITTED},
         "assumed": ASSUMED,
-        "cost": round(result.cost, 6),
+        "cost": result.cost,
         "evaluations": result.evaluations,
         "wall_time_s": round(result.wall_time, 1),
         "residuals_fit_seeds": _cell_rows(result.fit_cells),
         "residuals_check_seeds": _cell_rows(result.check_cells),
         "check_seeds": list(check_seeds),
-        "history": [{"values": {k: round(v, 6) for k, v in values.items()}, "cost": round(c, 6)}
+        "history": [{"values": dict(values), "cost": c}
                     for values, c in result.history],
     }
 

@@ -111,7 +111,8 @@ class CompressibleCircuit:
         out = np.empty((4, len(y)))
         _substeps(
             s.pressure_a, s.pressure_b, s.supply_pressure, s.line_flow, np.ascontiguousarray(conductance, dtype=float),
-            va, vb, friction.coulomb_force(fp, y, np.ones_like(y)), friction.coulomb_force(fp, y, -np.ones_like(y)),
+            va, vb, np.asarray(y, dtype=float), self.stroke[0], self.stroke[1],
+            friction.coulomb_force(fp, y, np.ones_like(y)), friction.coulomb_force(fp, y, -np.ones_like(y)),
             np.asarray(breakaway(y), dtype=float), np.asarray(v0, dtype=float), np.asarray(stuck, dtype=np.bool_),
             np.asarray(mass, dtype=float), np.asarray(external_force, dtype=float), self.source,
             self.area, fp.viscous, h / ch.substeps, ch.substeps, ch.leak_conductance,
@@ -129,16 +130,34 @@ def _line_step(pressure, flow, source, outflow, delta, compliance, inertance, re
 
 
 @numba.njit(cache=True)
-def _substeps(pa, pb, ps, q, conductance, va, vb, forward, backward, static, v0, stuck0, mass, external, source,
-              area, viscous, delta, n_sub, leak, air, inverse_water, p_atm, floor, has_line, compliance, inertance,
-              resistance, out):  # pragma: no cover - compiled
+def _rack_solve(momentum, v, push, damping, forward, backward, static, stuck):  # pragma: no cover - compiled
+    """Implicit rack velocity with Coulomb friction and stiction (as :func:`twin.hydraulics.rack_step`):
+    (v_new, dry friction force, stuck)."""
+    to_stop = -(momentum * v + push)
+    limit = backward if to_stop > 0 else forward  # friction opposes what to_stop resists
+    if stuck:
+        limit = max(limit, static)
+    if abs(to_stop) <= limit:
+        return 0.0, to_stop, True
+    dry = limit if to_stop > 0 else -limit
+    return (momentum * v + push + dry) / (momentum + damping), dry, False
+
+
+@numba.njit(cache=True)
+def _substeps(pa, pb, ps, q, conductance, va, vb, y, low, high, forward, backward, static, v0, stuck0, mass,
+              external, source, area, viscous, delta, n_sub, leak, air, inverse_water, p_atm, floor, has_line,
+              compliance, inertance, resistance, out):  # pragma: no cover - compiled
     """The sub-steps of one tick for every scenario, in place on pa, pb, ps, q; ``out`` rows: mean piston
-    force A, mean piston force B, final velocity, stuck (0/1). See :class:`CompressibleCircuit`."""
+    force A, mean piston force B, final velocity, stuck (0/1). See :class:`CompressibleCircuit`.
+
+    A pressure that would fall below the vapour floor is held there and the step re-solved with it
+    fixed (so the forces stay consistent with the velocity); at a stroke end the rack does not move
+    outwards (MuJoCo's joint limit holds it), so no flow is invented there."""
     for i in range(pa.shape[0]):
         g1, g2, g3, g4 = conductance[i, 0], conductance[i, 1], conductance[i, 2], conductance[i, 3]
         fill_a, fill_b = g1 + g2 + leak, g3 + g4 + leak
         momentum = mass[i] / delta
-        v, stuck = v0[i], stuck0[i]
+        v, stuck, position = v0[i], stuck0[i], y[i]
         sum_pa = sum_pb = sum_loss = 0.0
         for _ in range(n_sub):
             a0, b0, s0 = pa[i], pb[i], ps[i]
@@ -147,22 +166,25 @@ def _substeps(pa, pb, ps, q, conductance, va, vb, forward, backward, static, v0,
             den_a, den_b = 1.0 + ka * fill_a, 1.0 + kb * fill_b
             alpha_a, gamma_a = (a0 + ka * g1 * s0) / den_a, ka * area / den_a
             alpha_b, gamma_b = (b0 + kb * g3 * s0) / den_b, kb * area / den_b
-            push = area * (alpha_a - alpha_b) + external[i]
-            to_stop = -(momentum * v + push)
-            limit = backward[i] if to_stop > 0 else forward[i]  # friction opposes what to_stop resists
-            if stuck:
-                limit = max(limit, static[i])
-            stuck = abs(to_stop) <= limit
-            if stuck:
-                dry, v = to_stop, 0.0
-            else:
-                dry = limit if to_stop > 0 else -limit
-                v = (momentum * v + push + dry) / (momentum + area * (gamma_a + gamma_b) + viscous)
+            start_v, start_stuck = v, stuck
+            for _attempt in range(3):  # at most two pressures to pin to the floor
+                v, dry, stuck = _rack_solve(momentum, start_v, area * (alpha_a - alpha_b) + external[i],
+                                            area * (gamma_a + gamma_b) + viscous, forward[i], backward[i],
+                                            static[i], start_stuck)
+                if (position >= high and v > 0.0) or (position <= low and v < 0.0):
+                    v, dry = 0.0, 0.0
+                if alpha_a - gamma_a * v < floor and gamma_a != 0.0:
+                    alpha_a, gamma_a = floor, 0.0
+                elif alpha_b + gamma_b * v < floor and gamma_b != 0.0:
+                    alpha_b, gamma_b = floor, 0.0
+                else:
+                    break
             pa[i] = max(alpha_a - gamma_a * v, floor)
             pb[i] = max(alpha_b + gamma_b * v, floor)
             sum_pa += pa[i]
             sum_pb += pb[i]
             sum_loss += dry - viscous * v
+            position += delta * v
             if has_line:
                 ps[i], q[i] = _line_step(s0, q[i], source[i], g1 * (s0 - pa[i]) + g3 * (s0 - pb[i]), delta,
                                          compliance, inertance, resistance)

@@ -51,7 +51,7 @@ from dm_env import specs  # noqa: E402
 
 from twin.exceptions import InvalidScenario
 from twin.model import Orientation, build_mjcf, compile_joint
-from twin.plant_state import PlantState, place_on_manifold
+from twin.plant_state import PlantState, place_on_manifold, true_start
 from twin.scenario import Scenario
 from twin.ticks import whole_ticks
 from twin.trajectories import Reference, Segment, Trajectory, trajectory
@@ -91,7 +91,7 @@ class JointPhysics(dm_mujoco.Physics):
         self.pwm_ticks = whole_ticks(preset.params.valves.pwm_period, preset.timestep, what="PWM period")
         times = np.arange(ticks + PREVIEW * self.pwm_ticks + 1) * preset.timestep
         self.reference: Reference = episode.trajectory.sample(times, r_s)
-        y0 = np.array([episode.initial_angle * r_s])
+        y0 = true_start([s], np.array([episode.initial_angle * r_s]))  # the sensor reads the start angle
         place_on_manifold(self.data.qpos[None, :], self.joint, y0)
         self.data.qvel[:] = 0.0
         self.plant = PlantState(scenarios=[s], joints=[self.joint], lengths=[ticks + 1],

@@ -25,7 +25,7 @@ import numpy as np
 
 from twin.control import Setpoint
 from twin.model import compile_joint
-from twin.plant_state import PlantState, place_on_manifold
+from twin.plant_state import PlantState, place_on_manifold, true_start
 from twin.runner import thesis_controllers
 from twin.scenario import Scenario
 from twin.sensing import uniform_noise
@@ -70,7 +70,7 @@ class LiveJoint:
 
         first = trajectory(scenario.trajectory, spur_radius=self.spur_radius)
         self.plan, self.plan_start = first, 0.0
-        y0 = np.array([first.start * self.spur_radius])
+        y0 = true_start([scenario], np.array([first.start * self.spur_radius]))  # the sensor reads the start
         qpos = self.data.qpos[None, :].copy()
         place_on_manifold(qpos, self.joint, y0)
         self.data.qpos[:] = qpos[0]
@@ -158,5 +158,5 @@ class LiveJoint:
             time=self.time, angle=float(self.data.qpos[self.joint.spur_dof]),
             desired_angle=self.desired()[0] / self.spur_radius, duty=float(self.duty[0]),
             pressure_a=float(pa[0]), pressure_b=float(pb[0]),
-            supply_pressure=float(self.plant.supply[0]),
+            supply_pressure=float(self.plant.supply_now[0]),
             valve_open=tuple(bool(x) for x in self.plant.conductance[0] > 0))

@@ -211,7 +211,7 @@ class ChamberParams:
     initial_pressure_fraction: float = 0.5  # of the supply, in both chambers at the start (*assumed*: the
     # thesis pre-charges by moving the joint side to side; shut valves then trap a middle pressure)
     atmospheric_pressure: float = 101.325e3  # Pa
-    substeps: int = 10  # implicit sub-steps of the chamber/rack/supply model per physics tick
+    substeps: int = 400  # implicit sub-steps of the chamber/rack/supply model per physics tick
 
     def __post_init__(self) -> None:
         _require_positive(self, "water_bulk_modulus", "dead_volume", "atmospheric_pressure")
@@ -234,9 +234,9 @@ class SupplyLineParams:
     """
 
     model: str = "constant"
-    compliance: float = 2e-13  # m^3/Pa, C: hose wall and water at the valve block (calibrated)
-    natural_frequency: float = 60.0  # Hz, f_n of the line with C (calibrated)
-    damping_ratio: float = 0.3  # zeta of the line with C (calibrated)
+    compliance: float = 2e-13  # m^3/Pa, C: hose wall and water at the valve block (assumed)
+    natural_frequency: float = 60.0  # Hz, f_n of the line with C (assumed)
+    damping_ratio: float = 0.3  # zeta of the line with C (assumed)
     accumulator_compliance: float = 2e-11  # m^3/Pa, a 10 mL gas accumulator at 400 kPa abs (V / (gamma p))
 
     def __post_init__(self) -> None:
@@ -281,12 +281,14 @@ class StictionMapParams:
 
     Breakaway force F_s(y) = stiction + scatter u_k, piecewise linear between knots
     ``knot_spacing`` apart over the rack's stroke, u_k uniform in [-1, 1] from
-    ``seed`` (one map per joint, not per run). scatter = 0: a constant F_s.
+    ``seed``, or, with ``seed=None``, from the run's own seed: the map is not
+    known, so an ensemble of runs is an ensemble of plausible joints. scatter = 0:
+    a constant F_s.
     """
 
-    scatter: float = 0.0  # N (calibrated)
+    scatter: float = 0.0  # N (as-built: assumed 0.5 N)
     knot_spacing: float = 1e-3  # m
-    seed: int = 0
+    seed: int | None = None  # None: each run draws its own map from its scenario seed (an ensemble of joints)
 
     def __post_init__(self) -> None:
         _require_positive(self, "knot_spacing")

@@ -29,7 +29,7 @@ from twin.model import JointModel
 from twin.plants import Plant
 from twin.scenario import Scenario
 from twin.sensing import FirstOrderObserver, uniform_noise
-from twin.stiction_map import StictionMap
+from twin.stiction_map import StictionMaps
 from twin.valves import ValveBank
 
 
@@ -39,6 +39,17 @@ def groups(keys: Sequence) -> dict:
     for i, key in enumerate(keys):
         found.setdefault(key, []).append(i)
     return {key: np.array(idx) for key, idx in found.items()}
+
+
+def true_start(scenarios: Sequence[Scenario], reported: np.ndarray) -> np.ndarray:
+    """Where each rack truly starts (m) so that its Hall sensor reads ``reported`` (m): the
+    experiments started from where the reading said (as-built Hall calibration error)."""
+    start = np.array(reported, dtype=float)
+    for i, s in enumerate(scenarios):
+        params = s.preset.params
+        if params.hall.calibration_error:
+            start[i] = HallReading(params.hall, params.gears.spur_radius).true_position(start[i])
+    return start
 
 
 def place_on_manifold(qpos: np.ndarray, joint: JointModel, y: np.ndarray) -> None:
@@ -78,7 +89,8 @@ class PlantState:
         model = joints[0].model
         stroke = tuple(float(x) for x in model.jnt_range[model.dof_jntid[joints[0].rack_a_dof]])
         start = np.asarray(initial_position, dtype=float)
-        self._plant_groups = [_PlantGroup(preset, idx, tick=tick, stroke=stroke, supply=self.supply[idx])
+        self._plant_groups = [_PlantGroup(preset, idx, tick=tick, stroke=stroke, supply=self.supply[idx],
+                                          scenarios=[scenarios[i] for i in idx])
                               for preset, idx in groups(self.plants).items()]
         self.conductance = np.zeros((n, 4))  # m^3/(Pa s), V1..V4
         self.stuck = np.ones(n, dtype=bool)
@@ -150,11 +162,13 @@ class _PlantGroup:
     static-friction map and Hall reading (None where the plant does not have the effect)."""
 
     def __init__(self, preset: Plant, idx: np.ndarray, *, tick: float, stroke: tuple[float, float],
-                 supply: np.ndarray):
+                 supply: np.ndarray, scenarios: Sequence[Scenario]):
         params = preset.params
         self.preset, self.idx = preset, idx
         self.valves = ValveBank(params=params.valves, model=preset.valve_model, n=len(idx), tick=tick)
-        self.stiction = (StictionMap(params.stiction_map, params.friction.stiction, stroke)
+        map_seeds = [params.stiction_map.seed if params.stiction_map.seed is not None else (s.seed, 1)
+                     for s in scenarios]  # (seed, 1): the map's stream, apart from the noise's
+        self.stiction = (StictionMaps(params.stiction_map, params.friction.stiction, stroke, map_seeds)
                          if params.stiction_map.scatter > 0 else None)
         self.hall = (HallReading(params.hall, params.gears.spur_radius)
                      if params.hall.calibration_error else None)

@@ -30,7 +30,7 @@ from twin.exceptions import InvalidScenario, SimulationFailed
 from twin.metrics import Metrics, tracking_metrics
 from twin.model import JointModel, Orientation, compile_joint
 from twin.params import JointParams
-from twin.plant_state import PlantState, groups, place_on_manifold
+from twin.plant_state import PlantState, groups, place_on_manifold, true_start
 from twin.plants import Plant
 from twin.scenario import Scenario
 from twin.ticks import whole_ticks
@@ -121,11 +121,12 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     v_d = np.stack([ref.velocity for ref in references])
     a_d = np.stack([ref.acceleration for ref in references])
 
+    start = true_start(scenarios, y_d[:, 0])  # the Hall sensor reads the reference's start there
     for i, joint in enumerate(joints):
-        place_on_manifold(qpos[i:i + 1], joint, y_d[i:i + 1, 0])
+        place_on_manifold(qpos[i:i + 1], joint, start[i:i + 1])
     qvel[:] = 0.0
     batch.forward()
-    plant = PlantState(scenarios=scenarios, joints=joints, lengths=lengths, initial_position=y_d[:, 0], tick=h)
+    plant = PlantState(scenarios=scenarios, joints=joints, lengths=lengths, initial_position=start, tick=h)
 
     if len(controllers) != n:
         raise InvalidScenario(f"{len(controllers)} controllers for {n} scenarios")

@@ -12,6 +12,7 @@ s = 0 gives the constant F_s0. Forces in N, positions in m.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
@@ -32,6 +33,8 @@ class StictionMap:
         # Rounding keeps a float ratio such as 20.000000000000004 from adding a sliver interval.
         intervals = math.ceil(round((high - low) / params.knot_spacing, 9))
         knots = np.append(low + params.knot_spacing * np.arange(intervals), high)  # m, (K,)
+        if params.seed is None:
+            raise InvalidParameter("a stiction map needs a seed (StictionMaps gives each run its own)")
         u = np.random.default_rng(params.seed).uniform(-1.0, 1.0, knots.size)
         self.base = float(base)  # N
         self.scatter = params.scatter  # N
@@ -45,3 +48,23 @@ class StictionMap:
         if self.scatter == 0.0:
             return np.full(np.shape(y), self.base)
         return np.interp(y, self.knots, self.values)
+
+
+class StictionMaps:
+    """One :class:`StictionMap` per scenario, evaluated together: ``maps(y)`` with y (n,) -> (n,) in N.
+
+    ``seeds[i]`` draws scenario i's map, so an ensemble of runs spans the unknown
+    map as well as the sensor noise (the thesis gives no map, only its scatter)."""
+
+    def __init__(self, params: StictionMapParams, base: float, stroke: tuple[float, float], seeds) -> None:
+        maps = [StictionMap(dataclasses.replace(params, seed=seed), base, stroke) for seed in seeds]
+        self.knots = maps[0].knots  # m, (K,), shared
+        self.values = np.stack([m.values for m in maps])  # N, (n, K)
+        self._rows = np.arange(len(maps))
+
+    def __call__(self, y: np.ndarray) -> np.ndarray:
+        knots = self.knots
+        y = np.clip(y, knots[0], knots[-1])
+        i = np.clip(np.searchsorted(knots, y, side="right") - 1, 0, knots.size - 2)
+        t = (y - knots[i]) / (knots[i + 1] - knots[i])
+        return self.values[self._rows, i] * (1.0 - t) + self.values[self._rows, i + 1] * t

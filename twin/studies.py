@@ -269,11 +269,11 @@ def _ms(value: float) -> str:
 def paired_reversals(first: Sequence[Reversal], second: Sequence[Reversal], *,
                      window: float) -> list[tuple[Reversal | None, Reversal | None]]:
     """Both runs' reversals in time order, a reversal of ``first`` paired with one of ``second`` within
-    ``window`` (s) of it (the same step of the command, whichever way each turns); the others alone."""
+    ``window`` (s) of it that turns the same way (the same step of the command); the others alone."""
     unused = list(second)
     pairs: list[tuple[Reversal | None, Reversal | None]] = []
     for r in first:
-        match = next((m for m in unused if abs(m.time - r.time) <= window), None)
+        match = next((m for m in unused if abs(m.time - r.time) <= window and m.direction == r.direction), None)
         if match is not None:
             unused.remove(match)
         pairs.append((r, match))
@@ -310,8 +310,9 @@ def format_lags(runs: Sequence[OpenLoopRun]) -> str:
     return "\n".join(lines)
 
 
-def openloop_study(*, plant_name: str, reference_name: str = "thesis") -> OpenLoopStudy:
-    """The §4.6 input on the thesis model and on ``plant_name`` (run once if they are the same)."""
+def openloop_study(*, plant_name: str, reference_name: str = "thesis-deadzone") -> OpenLoopStudy:
+    """The §4.6 input on the thesis model (eq. 4.4.1 with §4.6's 30 % dead zone: ``thesis-deadzone``)
+    and on ``plant_name`` (run once if they are the same)."""
     reference = openloop_run(reference_name)
     runs = (reference, reference if plant_name == reference_name else openloop_run(plant_name))
     if not np.array_equal(runs[0].time, runs[1].time):
