@@ -347,7 +347,7 @@ def test_a_page_that_has_not_taken_its_last_frame_gets_no_new_one():
     try:
         class Page:
             def __init__(self, done):
-                self.sent, self.done = [], done
+                self.sent, self.done, self.pending_frame = [], done, None
 
             def write_message(self, message, binary=False):
                 self.sent.append(message)

@@ -44,12 +44,6 @@ from twin.params import ChamberParams, FrictionParams, SupplyLineParams
 VAPOUR_MARGIN = 2e3  # Pa above absolute zero: the lowest chamber pressure (cavitation)
 
 
-def bulk_modulus(params: ChamberParams, pressure: np.ndarray) -> np.ndarray:
-    """beta_eff (Pa) at gauge ``pressure``: 1 / beta = 1 / beta_w + x_air p_atm / p_abs^2."""
-    absolute = np.maximum(pressure + params.atmospheric_pressure, VAPOUR_MARGIN)
-    return 1.0 / (1.0 / params.water_bulk_modulus + params.air_fraction * params.atmospheric_pressure / absolute**2)
-
-
 @dataclasses.dataclass
 class ChamberState:
     """The hydraulic state of n scenarios between ticks; arrays are (n,)."""
@@ -73,7 +67,7 @@ class CompressibleCircuit:
 
     def __init__(self, *, chambers: ChamberParams, line: SupplyLineParams, friction_params: FrictionParams,
                  bore_area: float, stroke: tuple[float, float], supply: np.ndarray, initial_pressure: np.ndarray):
-        self.chambers, self.line, self.friction = chambers, line, friction_params
+        self.chambers, self.friction = chambers, friction_params
         self.area, self.stroke = bore_area, stroke
         self.source = np.asarray(supply, dtype=float)  # P_0, Pa
         self.state = ChamberState(
@@ -107,12 +101,13 @@ class CompressibleCircuit:
         position (the rack moves at most 0.15 mm in a tick: 0.5 % of a chamber)."""
         s, ch, fp = self.state, self.chambers, self.friction
         va, vb = self.volumes(y)
+        forward = friction.coulomb_force(fp, y, np.ones_like(y))  # towards +y; towards 0 deg it is scaled
         line = self._line if self._line is not None else (1.0, 1.0, 0.0)
         out = np.empty((4, len(y)))
         _substeps(
             s.pressure_a, s.pressure_b, s.supply_pressure, s.line_flow, np.ascontiguousarray(conductance, dtype=float),
             va, vb, np.asarray(y, dtype=float), self.stroke[0], self.stroke[1],
-            friction.coulomb_force(fp, y, np.ones_like(y)), friction.coulomb_force(fp, y, -np.ones_like(y)),
+            forward, forward * fp.ccw_coulomb_scale,
             np.asarray(breakaway(y), dtype=float), np.asarray(v0, dtype=float), np.asarray(stuck, dtype=np.bool_),
             np.asarray(mass, dtype=float), np.asarray(external_force, dtype=float), self.source,
             self.area, fp.viscous, h / ch.substeps, ch.substeps, ch.leak_conductance,

@@ -263,11 +263,9 @@ def _whatif_values(args: argparse.Namespace, plant_name: str) -> list | None:
 
 
 def _cmd_whatif(args: argparse.Namespace) -> int:
-    import csv
-
     from tqdm import tqdm
 
-    from twin import whatif
+    from twin import tables, whatif
     from viz.whatif_plots import PLOTS
 
     plant_name = args.plant or whatif.DEFAULT_PLANTS[args.study]
@@ -286,10 +284,7 @@ def _cmd_whatif(args: argparse.Namespace) -> int:
         else:
             study = whatif.gear_load_study(plant_name=plant_name)
     stem = args.out / args.study
-    with open(stem.with_suffix(".csv"), "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(study.rows[0]))
-        writer.writeheader()
-        writer.writerows(study.rows)
+    tables.write_csv(study.rows, list(study.rows[0]), stem.with_suffix(".csv"))
     PLOTS[args.study](study.rows, stem.with_suffix(".png"))
     stem.with_suffix(".txt").write_text(study.answer + "\n")
     print(study.answer)

@@ -101,18 +101,18 @@ class PlantState:
             if group.chambers is not None:
                 self.pressure_a[group.idx] = group.chambers.state.pressure_a
                 self.pressure_b[group.idx] = group.chambers.state.pressure_b
+        self._halls = [(g.idx, g.hall) for g in self._plant_groups if g.hall is not None]
         self.observer = FirstOrderObserver(
             gain=np.array([p.params.observer.gain for p in self.plants]), sample_period=tick,
             initial=self._hall(start) + self.position_noise[:, 0])
 
     def _hall(self, y: np.ndarray) -> np.ndarray:
         """The rack position the Hall sensor reports for the true ``y``, before noise."""
-        if all(group.hall is None for group in self._plant_groups):
+        if not self._halls:
             return y
         read = y.copy()
-        for group in self._plant_groups:
-            if group.hall is not None:
-                read[group.idx] = group.hall(y[group.idx])
+        for idx, hall in self._halls:
+            read[idx] = hall(y[idx])
         return read
 
     def sense(self, k: int, y: np.ndarray) -> Measurement:
@@ -143,7 +143,7 @@ class PlantState:
                     circuit_now=hydraulics.circuit(self.conductance[idx], self.supply[idx], area),
                     friction_params=params.friction, bore_area=area, y=y[idx], v0=v[idx],
                     external_force=external[idx], stuck=self.stuck[idx], mass=self.mass[idx], h=self.tick,
-                    breakaway=None if group.stiction is None else group.stiction(y[idx]))
+                    breakaway=group.breakaway(y[idx]))
                 self.pressure_a[idx], self.pressure_b[idx] = forces.pressure_a, forces.pressure_b
             else:
                 forces = group.chambers.tick(

@@ -20,7 +20,6 @@ Degrees, grams and milliseconds only in the rows, tables and answers.
 
 from __future__ import annotations
 
-import csv
 import dataclasses
 import math
 import pathlib
@@ -33,7 +32,7 @@ from twin.exceptions import InvalidScenario
 from twin.grid import GridPoint, expand
 from twin.plants import PLANTS, plant
 from twin.sweep import run_sweep
-from twin.tables import summarise
+from twin.tables import summarise, write_csv
 
 # --- robustness (SPEC §9) ---------------------------------------------------------------------------------------
 
@@ -117,18 +116,11 @@ def robustness_study(*, out: pathlib.Path, plant_name: str, seeds: int = ROBUSTN
     return RobustnessStudy(runs=[run_row(r) for r in records], summary=summary_rows(records), seeds=seeds)
 
 
-def _write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
-    with open(path, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(columns), extrasaction="ignore")
-        writer.writeheader()
-        writer.writerows({c: ("" if row[c] is None else row[c]) for c in columns} for row in rows)
-
-
 def write_robustness(study: RobustnessStudy, out: pathlib.Path) -> list[pathlib.Path]:
     """``robustness_runs.csv`` and ``robustness_summary.csv``; the plot is ``viz.study_plots``'s."""
     paths = [out / "robustness_runs.csv", out / "robustness_summary.csv"]
-    _write_csv(study.runs, RUN_COLUMNS, paths[0])
-    _write_csv(study.summary, SUMMARY_COLUMNS, paths[1])
+    write_csv(study.runs, RUN_COLUMNS, paths[0])
+    write_csv(study.summary, SUMMARY_COLUMNS, paths[1])
     return paths
 
 
@@ -332,5 +324,5 @@ def write_openloop(study: OpenLoopStudy, out: pathlib.Path) -> pathlib.Path:
     """``openloop.csv``: t_s, then the duty (%) and angle (deg) of each plant (each plant's own duty: the
     soft limits act on its own measured position)."""
     path = out / "openloop.csv"
-    _write_csv(study.rows, list(study.rows[0]), path)
+    write_csv(study.rows, list(study.rows[0]), path)
     return path

@@ -17,13 +17,14 @@ SUMMARY_COLUMNS = GROUP_BY + ("runs", "failed", "rmse_mean_deg", "rmse_std_deg",
                               "sse_mean_deg", "sse_min_deg", "sse_max_deg", "max_error_deg")
 
 
-def _csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
+def write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
+    """``rows`` as CSV with ``columns`` (lists joined with ';', None empty), written whole or not at all."""
     tmp = path.with_suffix(path.suffix + ".tmp")
     with open(tmp, "w", newline="") as handle:
         writer = csv.DictWriter(handle, fieldnames=list(columns), extrasaction="ignore")
         writer.writeheader()
         for row in rows:
-            writer.writerow({c: (";".join(row[c]) if c == "warnings" else row[c]) for c in columns})
+            writer.writerow({c: (";".join(row[c]) if isinstance(row[c], list | tuple) else row[c]) for c in columns})
     tmp.replace(path)  # never a half-written file
 
 
@@ -32,7 +33,7 @@ def write_results(rows: Sequence[dict], out: pathlib.Path) -> None:
     import pyarrow as pa
     import pyarrow.parquet as pq
 
-    _csv(rows, COLUMNS, out / "results.csv")
+    write_csv(rows, COLUMNS, out / "results.csv")
     table = pa.table({c: [(";".join(r[c]) if c == "warnings" else r[c]) for r in rows] for c in COLUMNS})
     pq.write_table(table, out / "results.parquet.tmp")
     (out / "results.parquet.tmp").replace(out / "results.parquet")
@@ -58,7 +59,7 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
 
 
 def write_summary(summary: Sequence[dict], out: pathlib.Path) -> None:
-    _csv(summary, SUMMARY_COLUMNS, out / "summary.csv")
+    write_csv(summary, SUMMARY_COLUMNS, out / "summary.csv")
 
 
 def format_summary(summary: Sequence[dict], limit: int = 40) -> str:

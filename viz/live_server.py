@@ -24,6 +24,7 @@ import os
 import pathlib
 import sys
 import time
+import urllib.parse
 from collections.abc import Callable
 
 import mujoco
@@ -38,7 +39,7 @@ from meshcat.commands import Delete
 from meshcat.path import Path
 
 from twin.exceptions import SimulationFailed, TwinError
-from twin.live import LiveJoint
+from twin.live import LiveJoint, Readout
 from twin.scenario import Scenario
 from viz import live_messages
 from viz.recording import FPS, MESHCAT_SCRIPT, TraceRows, title_of, write_page
@@ -48,7 +49,7 @@ FRAME_RATE = 30.0  # pictures per second of wall time
 MIN_REBUILD_INTERVAL = 0.5  # s between model rebuilds (each compiles the model on the server's thread)
 MAX_LAG_FRAMES = 3.0  # a late picture catches up at most this many frames of simulated time
 MAX_MESSAGE_BYTES = 4096  # tornado refuses larger WebSocket messages before they are read
-LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "[::1]")
+LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 MAX_RECORDED_FRAMES = 10 * 60 * FPS  # a --html recording keeps the last 10 minutes
 PAGE = pathlib.Path(__file__).with_name("live_page.html")
 
@@ -89,6 +90,7 @@ class LiveSession:
         self.joint = LiveJoint(scenario)
         self.scene = JointScene(self.joint.joint, supply_pressure=scenario.supply)
         self.recorder = _Recorder()
+        self._debt = 0.0  # s of simulated time asked for but not yet a whole tick
         self.record_every = max(1, round(1.0 / (FPS * self.joint.tick)))
         self._capture()
 
@@ -99,21 +101,21 @@ class LiveSession:
     def setup_commands(self) -> list[dict]:
         return [Delete(Path(("twin",))).lower(), *self.scene.setup_commands()]
 
-    def frame(self) -> Frame:
-        r = self.joint.readout()
+    def frame(self, r: Readout | None = None) -> Frame:
+        r = self.joint.readout() if r is None else r
         return self.scene.frame(self.joint.data, desired_angle=r.desired_angle,
                                 pressures=(r.pressure_a, r.pressure_b), valve_open=r.valve_open)
 
     def _capture(self) -> None:
         if self.record:
             r = self.joint.readout()
-            self.recorder.add(self.frame(), (r.time, r.angle, r.desired_angle, r.duty, r.pressure_a,
+            self.recorder.add(self.frame(r), (r.time, r.angle, r.desired_angle, r.duty, r.pressure_a,
                                              r.pressure_b, r.supply_pressure))
 
     def advance(self, duration: float) -> None:
         """Step ``duration`` seconds; the fraction of a tick left over is carried to the next call.
         Raises SimulationFailed on a MuJoCo warning or a non-finite state."""
-        self._debt = getattr(self, "_debt", 0.0) + duration
+        self._debt += duration
         ticks = int(self._debt / self.joint.tick + 1e-9)
         self._debt -= ticks * self.joint.tick
         for _ in range(ticks):
@@ -187,9 +189,7 @@ def _host_allowed(handler: tornado.web.RequestHandler, viewer: LiveViewer) -> bo
     """Bound to loopback, answer only requests addressed to loopback (no DNS rebinding)."""
     if viewer.host not in ("127.0.0.1", "::1", "localhost"):
         return True
-    host = handler.request.host.rsplit(":", 1)[0] if not handler.request.host.startswith("[") \
-        else handler.request.host.split("]")[0] + "]"
-    return host in LOOPBACK_HOSTS
+    return urllib.parse.urlsplit("//" + handler.request.host).hostname in LOOPBACK_HOSTS
 
 
 class _PageHandler(tornado.web.RequestHandler):
@@ -212,6 +212,7 @@ class _ScriptHandler(tornado.web.RequestHandler):
 class _SocketHandler(tornado.websocket.WebSocketHandler):
     def initialize(self, viewer: LiveViewer) -> None:
         self.viewer = viewer
+        self.pending_frame = None  # the write of the last frame sent, while it is in flight
 
     def prepare(self):
         if not _host_allowed(self, self.viewer):
@@ -258,8 +259,7 @@ class LiveViewer:
         """Send ``messages`` to every page; ``droppable`` ones (a frame) skip a page that has not
         yet taken the previous frame, so a stalled tab cannot pile up memory."""
         for client in list(self.clients):
-            pending = getattr(client, "pending_frame", None)
-            if droppable and pending is not None and not pending.done():
+            if droppable and client.pending_frame is not None and not client.pending_frame.done():
                 continue
             for message in messages:
                 sent = _send(client, message)

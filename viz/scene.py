@@ -266,6 +266,10 @@ def rack_teeth_layout(*, travel: tuple[float, float], teeth: int, pinion_radius:
     return count * pitch, float(centre)
 
 
+def _path(text: str) -> Path:
+    return Path(tuple(text.strip("/").split("/")))
+
+
 def _mesh(mesh) -> g.TriangularMeshGeometry:
     vertices, faces = mesh
     return g.TriangularMeshGeometry(np.asarray(vertices, dtype=np.float32), np.asarray(faces, dtype=np.uint32))
@@ -273,10 +277,9 @@ def _mesh(mesh) -> g.TriangularMeshGeometry:
 
 def frame_commands(frame: Frame) -> list[dict]:
     """meshcat commands that show ``frame`` (live viewing)."""
-    commands = [SetTransform(matrix, Path(tuple(path.strip("/").split("/")))).lower()
-                for path, matrix in frame.transforms.items()]
+    commands = [SetTransform(matrix, _path(path)).lower() for path, matrix in frame.transforms.items()]
     commands += [SetProperty("color", [*rgb, 0.85 if "chambers" in path else 1.0],
-                             Path(tuple(path.strip("/").split("/")))).lower()
+                             _path(path)).lower()
                  for path, rgb in frame.colours.items()]
     return commands
 
