@@ -51,6 +51,12 @@ def test_run_json_prints_one_record(tmp_path):
     assert list(tmp_path.iterdir()) == []  # --json alone writes nothing
 
 
+def test_plain_summary_of_a_run_that_ends_moving_says_it_has_no_steady_error(tmp_path):
+    proc = twin(tmp_path, "run", "--controller", "smc", "--trajectory", "3", "--seed", "0")
+    assert proc.returncode == 0, proc.stderr
+    assert "SSE none (ends moving)" in proc.stdout and "RMSE " in proc.stdout
+
+
 BASE = ["run", "--controller", "ffpva", "--trajectory", "1"]
 
 

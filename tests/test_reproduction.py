@@ -33,13 +33,7 @@ def _mean_rmse_deg(controller: str, trajectory: int) -> float:
     return float(np.mean([math.degrees(r.metrics.rmse) for r in _results(controller)[trajectory]]))
 
 
-T2_GAP = ("Known gap: the twin tracks the T2 ramp better than the thesis's simulation (0.46 vs 0.83 deg, 0.37 apart). "
-          "The thesis does not describe its valve and delay implementation; the twin's averaged valve "
-          "follows eq. 4.4.2 down to one PWM tick. See README, Reproduction.")
-
-
-@pytest.mark.parametrize("trajectory", [
-    1, pytest.param(2, marks=pytest.mark.xfail(strict=True, reason=T2_GAP)), 3, 4])
+@pytest.mark.parametrize("trajectory", [1, 2, 3, 4])
 def test_ffpva_mean_rmse_is_within_0_35_deg_of_the_thesis_simulation(trajectory):
     twin = _mean_rmse_deg("ffpva", trajectory)
     thesis = THESIS_SIMULATED_RMSE_DEG["ffpva"][trajectory]

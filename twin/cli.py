@@ -114,7 +114,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
     if args.json:
         print(json.dumps(record))
     else:
-        print(f"RMSE {record['rmse_deg']:.3f} deg  SSE {record['sse_deg']:.3f} deg  "
+        sse = "none (ends moving)" if record["sse_deg"] is None else f"{record['sse_deg']:.3f} deg"
+        print(f"RMSE {record['rmse_deg']:.3f} deg  SSE {sse}  "
               f"max |e| {record['max_error_deg']:.3f} deg  ({record['duration_s']:.2f} s simulated)")
         for warning in record["warnings"]:
             print(f"warning: {warning}")

@@ -8,7 +8,10 @@ thesis does not state are chosen inside the friction fit's range
 #   start    duration   shape
 ==  =======  =========  ==========================================================
 T1  30 deg   3.0 s      +120 deg cycloid in 1 s to 150 deg, hold 2 s
-T2  30 deg   2.0 s      ramp at 10 mm/s rack speed to 150 deg (0.998 s), hold to 2 s
+T2  30 deg   1.0 s      ramp at 10 mm/s rack speed for 1 s (10 mm, 120.3 deg, to 150.3 deg);
+                        like T3 it ends moving, so it has no steady error: SPEC §7 gives
+                        T1 a hold and T4 its rests but T2 none, and the thesis reports
+                        steady errors for T1 and T4 only
 T3  80 deg   4.0 s      80 + 60 sin(pi t) deg: 0.5 Hz, 20 - 140 deg as SPEC §7 says
                         (so it dips below the fit), two periods, starting mid-stroke
                         at full speed (the thesis reports its largest error at the
@@ -115,10 +118,11 @@ def _deg(x: float) -> float:
 START = math.radians(30.0)  # rad, T1, T2 and T4: inside the friction fit (y = 2.49 mm)
 
 
+RAMP_TIME = 1.0  # s, T2's length: 10 mm of rack travel, a whole number of ticks
+
+
 def _t2(spur_radius: float) -> Trajectory:
-    rise = _deg(120.0)
-    ramp_time = rise * spur_radius / RAMP_SPEED
-    return Trajectory(2, START, (Segment("ramp", ramp_time, rise), Segment("rest", 2.0 - ramp_time)))
+    return Trajectory(2, START, (Segment("ramp", RAMP_TIME, RAMP_SPEED * RAMP_TIME / spur_radius),))
 
 
 def trajectory(number: int, *, spur_radius: float) -> Trajectory:
