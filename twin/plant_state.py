@@ -52,6 +52,21 @@ def true_start(scenarios: Sequence[Scenario], reported: np.ndarray) -> np.ndarra
     return start
 
 
+def compile_kernels() -> None:
+    """Compile, or load from numba's cache, the per-tick kernels of the valves and the rack step:
+    about 0.3 s the first time in a process (mostly numba starting up). A sweep calls it before
+    forking its workers, so that each inherits them instead of paying again."""
+    from twin.params import NOMINAL_PARAMS
+    from twin.valves import ValveModel
+
+    nothing = np.zeros(0)
+    for model in ValveModel:
+        ValveBank(params=NOMINAL_PARAMS.valves, model=model, n=0, tick=1e-3).update(0, nothing)
+    hydraulics.rack_step(circuit_now=hydraulics.circuit(np.zeros((0, 4)), nothing, 1.0),
+                         friction_params=NOMINAL_PARAMS.friction, bore_area=1.0, y=nothing, v0=nothing,
+                         external_force=nothing, stuck=np.zeros(0, dtype=bool), mass=nothing, h=1e-3)
+
+
 def place_on_manifold(qpos: np.ndarray, joint: JointModel, y: np.ndarray) -> None:
     """Write rack position(s) ``y`` (m) into ``qpos`` rows (n, nq) with the gears coupled."""
     dofs = [joint.rack_a_dof, joint.rack_b_dof, joint.pinion_dof, joint.spur_dof]

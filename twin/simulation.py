@@ -140,8 +140,10 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     failures: dict[int, str] = {}
     active = np.flatnonzero(lengths > 1)  # scenario i is stepped at ticks 0 .. lengths[i] - 2
     ends = {int(length) for length in lengths}
-    rec = {name: np.zeros((n, ticks)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps", "fs", "fa", "fb")}
-    valve_open = np.zeros((n, ticks, 4), dtype=bool)
+    # Recorded tick-major, (ticks, n): each tick writes contiguous rows.
+    rec = {name: np.zeros((ticks, n)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps", "fs", "fa", "fb")}
+    valve_open = np.zeros((ticks, n, 4), dtype=bool)
+    stage_vel = int(mujoco.mjtStage.mjSTAGE_VEL)
     for k in range(ticks):
         y = qpos[:, dof.rack_a_dof].copy()
         v = qvel[:, dof.rack_a_dof].copy()
@@ -151,26 +153,26 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
                 setpoint = Setpoint(position=y_d[idx, k], velocity=v_d[idx, k], acceleration=a_d[idx, k])
                 duty[idx] = controller.update(k * h, measurement.subset(idx), setpoint)
         ctrl[:, 0], ctrl[:, 1] = plant.actuate(k, duty, y, v, plant.external_force(qfrc_passive, qfrc_bias))
-        rec["y"][:, k] = y
-        rec["ym"][:, k] = measurement.position
-        rec["theta"][:, k] = qpos[:, dof.spur_dof]
-        rec["duty"][:, k] = duty
-        rec["pa"][:, k] = plant.pressure_a
-        rec["pb"][:, k] = plant.pressure_b
-        rec["ps"][:, k] = plant.supply_now
-        valve_open[:, k] = plant.conductance > 0
+        rec["y"][k] = y
+        rec["ym"][k] = measurement.position
+        rec["theta"][k] = qpos[:, dof.spur_dof]
+        rec["duty"][k] = duty
+        rec["pa"][k] = plant.pressure_a
+        rec["pb"][k] = plant.pressure_b
+        rec["ps"][k] = plant.supply_now
+        valve_open[k] = plant.conductance > 0
         if k + 1 in ends:
             active = active[lengths[active] > k + 1]
         try:  # derived fields (gravity) at the new state; a finished scenario stops here
-            batch.step(ids=active, stage=int(mujoco.mjtStage.mjSTAGE_VEL))
+            batch.step(ids=None if len(active) == n else active, stage=stage_vel)
         except mujoco.batch.SimulationError as error:
             for i in error.ids:
                 failures[int(i)] = f"MuJoCo error at t = {k * h:.3f} s: {batch.error(int(i))}"
             active = np.array([i for i in active if int(i) not in failures], dtype=int)
         # Constraint forces of this step (computed at tick k's state; not refreshed by the stage above).
-        rec["fs"][:, k] = np.abs(qfrc_constraint[:, dof.spur_dof]) / spur_radius
-        rec["fa"][:, k] = np.abs(qfrc_constraint[:, dof.rack_a_dof])
-        rec["fb"][:, k] = np.abs(qfrc_constraint[:, dof.rack_b_dof])
+        rec["fs"][k] = np.abs(qfrc_constraint[:, dof.spur_dof]) / spur_radius
+        rec["fa"][k] = np.abs(qfrc_constraint[:, dof.rack_a_dof])
+        rec["fb"][k] = np.abs(qfrc_constraint[:, dof.rack_b_dof])
         if progress is not None and (k % PROGRESS_EVERY == 0 or k == ticks - 1):
             progress(k + 1, ticks)
 
@@ -178,7 +180,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     results = []
     for i, s in enumerate(scenarios):
         T = lengths[i]
-        theta = rec["theta"][i, :T]
+        series = {name: rec[name][:T, i].copy() for name in rec}  # contiguous per run
+        theta = series["theta"]
         desired = y_d[i, :T] / spur_radius[i]
         warnings = _warnings(batch.get_data(i))
         if i in failures:
@@ -186,15 +189,14 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         if not np.all(np.isfinite(theta)):
             warnings += ("state is not finite",)
         trace = Trace(
-            time=t[:T], desired_angle=desired, angle=theta, rack_position=rec["y"][i, :T],
-            measured_position=rec["ym"][i, :T], duty=rec["duty"][i, :T], valve_open=valve_open[i, :T],
-            pressure_a=rec["pa"][i, :T], pressure_b=rec["pb"][i, :T], supply_pressure=rec["ps"][i, :T],
-            coupling_error=theta - rec["y"][i, :T] / spur_radius[i],
-            tooth_force_spur=rec["fs"][i, :T], tooth_force_rack_a=rec["fa"][i, :T],
-            tooth_force_rack_b=rec["fb"][i, :T],
+            time=t[:T], desired_angle=desired, angle=theta, rack_position=series["y"],
+            measured_position=series["ym"], duty=series["duty"], valve_open=valve_open[:T, i].copy(),
+            pressure_a=series["pa"], pressure_b=series["pb"], supply_pressure=series["ps"],
+            coupling_error=theta - series["y"] / spur_radius[i],
+            tooth_force_spur=series["fs"], tooth_force_rack_a=series["fa"], tooth_force_rack_b=series["fb"],
         )
         tr_i = trajectories[i]
-        scored = rec["ym"][i, :T] / spur_radius[i] if plants[i].metrics_on_sensor else theta
+        scored = series["ym"] / spur_radius[i] if plants[i].metrics_on_sensor else theta
         metrics = tracking_metrics(desired, scored, ends_at_rest=tr_i.ends_at_rest,
                                    rest_end_ticks=[int(round(e / h)) - 1 for e in tr_i.rest_ends()])
         results.append(Result(scenario=s, trace=trace, metrics=metrics, warnings=warnings, wall_time=wall))

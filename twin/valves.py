@@ -27,13 +27,15 @@ for ``opening_delay``, an open valve shuts once its coil has been off for
 ``closing_delay`` (a state machine per valve). So a coil pulse shorter than the
 opening delay never opens the valve, and a gap shorter than the closing delay
 never shuts it (>= 7 ms per on/off cycle, §3). While open, a valve has the
-conductance of its coil's latest command.
+conductance of its coil's latest command. The per-tick update is one compiled
+loop over the scenarios (numba), like the hydraulics it feeds.
 """
 
 from __future__ import annotations
 
 import enum
 
+import numba
 import numpy as np
 
 from twin.exceptions import InvalidScenario
@@ -82,36 +84,49 @@ class ValveBank:
         self._open[:] = False
         self._conductance[:] = 0.0
 
-    def _coil_conductance(self, tick: int, duty: np.ndarray) -> np.ndarray:
-        """Conductance each valve would have with no delay, (n, 4)."""
-        magnitude = np.minimum(np.abs(duty), 100.0)
-        if self.duty_steps:  # the coil switches on the DAQ's tick: a period of S ticks realises duties in 100/S % steps
-            realised = np.rint(magnitude / 100.0 * self.duty_steps) * (100.0 / self.duty_steps)
-        else:
-            realised = magnitude
-        energised = (realised > 0) & (magnitude >= self.params.dead_zone_duty)
-        if self.model is ValveModel.AVERAGED:
-            drain = np.where(energised, 1.0 / self.params.resistance(np.maximum(realised, 1e-9)), 0.0)
-        else:
-            in_pulse = (tick % self.period_ticks) < np.rint(realised / 100.0 * self.period_ticks)
-            drain = np.where(energised & in_pulse, self.full_conductance, 0.0)
-        supply = np.where(energised, self.full_conductance, 0.0)
-        forward, backward = duty > 0, duty < 0
-        coil = np.zeros((self.n, 4))
-        coil[:, SUPPLY_A] = np.where(forward, supply, 0.0)
-        coil[:, DRAIN_B] = np.where(forward, drain, 0.0)
-        coil[:, SUPPLY_B] = np.where(backward, supply, 0.0)
-        coil[:, DRAIN_A] = np.where(backward, drain, 0.0)
-        return coil
-
     def update(self, tick: int, duty: np.ndarray) -> np.ndarray:
         """Valve conductances (n, 4) in m^3/(Pa s) at integer ``tick`` for signed ``duty`` (n,) in %."""
-        coil = self._coil_conductance(tick, duty)
-        on = coil > 0.0
-        self._on_run = np.where(on, self._on_run + 1, 0)
-        self._off_run = np.where(on, 0, self._off_run + 1)
-        opens = ~self._open & (self._on_run > self.open_ticks)
-        shuts = self._open & (self._off_run > self.close_ticks)
-        self._open = (self._open | opens) & ~shuts
-        self._conductance = np.where(on, coil, self._conductance)
-        return np.where(self._open, self._conductance, 0.0)
+        p = self.params
+        out = np.empty((self.n, 4))
+        _valve_tick(np.ascontiguousarray(duty, dtype=float), tick, self.duty_steps, self.period_ticks,
+                    self.model is ValveModel.AVERAGED, p.dead_zone_duty, p.resistance_coefficient,
+                    p.resistance_exponent, self.full_conductance, self.open_ticks, self.close_ticks,
+                    self._on_run, self._off_run, self._open, self._conductance, out)
+        return out
+
+
+@numba.njit(cache=True)
+def _coil(magnitude, tick, duty_steps, period_ticks, averaged, dead_zone, coefficient, exponent,
+          full):  # pragma: no cover - compiled
+    """(supply, drain) coil conductance of the open pair with no delay, for |duty| ``magnitude`` <= 100 %."""
+    if duty_steps:  # the coil switches on the DAQ's tick: a period of S ticks realises duties in 100/S % steps
+        realised = np.rint(magnitude / 100.0 * duty_steps) * (100.0 / duty_steps)
+    else:
+        realised = magnitude
+    if not (realised > 0 and magnitude >= dead_zone):
+        return 0.0, 0.0
+    if averaged:  # eq. 4.4.2 for the whole period
+        return full, 1.0 / (coefficient * max(realised, 1e-9) ** exponent)
+    in_pulse = (tick % period_ticks) < np.rint(realised / 100.0 * period_ticks)
+    return full, full if in_pulse else 0.0
+
+
+@numba.njit(cache=True)
+def _valve_tick(duty, tick, duty_steps, period_ticks, averaged, dead_zone, coefficient, exponent, full,
+                open_ticks, close_ticks, on_run, off_run, is_open, conductance, out):  # pragma: no cover - compiled
+    """One tick of every valve, in place on the delay state; ``out`` (n, 4) the conductances in force."""
+    for i in range(duty.shape[0]):
+        supply, drain = _coil(min(abs(duty[i]), 100.0), tick, duty_steps, period_ticks, averaged, dead_zone,
+                              coefficient, exponent, full)
+        coil = (supply if duty[i] > 0 else 0.0, drain if duty[i] < 0 else 0.0,
+                supply if duty[i] < 0 else 0.0, drain if duty[i] > 0 else 0.0)  # V1..V4
+        for j in range(4):
+            on = coil[j] > 0.0
+            on_run[i, j] = on_run[i, j] + 1 if on else 0
+            off_run[i, j] = 0 if on else off_run[i, j] + 1
+            opens = not is_open[i, j] and on_run[i, j] > open_ticks
+            shuts = is_open[i, j] and off_run[i, j] > close_ticks
+            is_open[i, j] = (is_open[i, j] or opens) and not shuts
+            if on:
+                conductance[i, j] = coil[j]
+            out[i, j] = conductance[i, j] if is_open[i, j] else 0.0
