@@ -136,9 +136,10 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
         for chunk in chunks:
             on_done(run_chunk(chunk))
         return
+    import twin.runner  # noqa: F401 - imported and compiled once here, inherited by every forked worker
     from twin.plant_state import compile_kernels
 
-    compile_kernels()  # once here, inherited by every forked worker
+    compile_kernels()
     context = multiprocessing.get_context("fork")
     with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
         futures = [pool.submit(run_chunk, chunk) for chunk in chunks]
