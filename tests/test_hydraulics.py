@@ -119,3 +119,18 @@ def test_drive_above_stiction_breaks_away():
     out = step(_drive_of(3.8), friction=friction, v0=0.0, stuck=True)
     assert out.velocity[0] > 0.0
     assert not out.stuck[0]
+
+
+def test_scalar_inputs_broadcast_over_the_scenarios():
+    """The compiled step reads every per-scenario input at each index: a scalar must mean 'the same for all'."""
+    c = circuit(np.repeat(one(1 / R1, 0.0, 0.0, 1 / R4), 3, axis=0), np.array(P_WS), AREA)
+    out = rack_step(circuit_now=c, friction_params=NO_FRICTION, bore_area=AREA, y=np.full(3, 8e-3), v0=0.0,
+                    external_force=0.0, stuck=False, mass=0.04, h=H, breakaway=0.0)
+    assert out.velocity[0] > 0 and np.all(out.velocity == out.velocity[0])
+
+
+def test_a_circuit_does_not_follow_later_changes_to_its_inputs():
+    g = one(1 / R1, 0.0, 0.0, 1 / R4)
+    c = circuit(g, np.array([P_WS]), AREA)
+    g[:] = 0.0
+    assert c.drive[0] == pytest.approx(P_WS * AREA, rel=1e-12) and not c.sealed[0]

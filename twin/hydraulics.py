@@ -107,8 +107,9 @@ class Circuit:
 
 def circuit(conductances: np.ndarray, supply_pressure: np.ndarray, bore_area: float) -> Circuit:
     """The valve network; ``conductances`` (n, 4) for V1..V4, pressure (n,) in Pa."""
-    return Circuit(conductances=np.ascontiguousarray(conductances, dtype=float),
-                   supply_pressure=np.ascontiguousarray(supply_pressure, dtype=float), bore_area=float(bore_area))
+    g = np.array(conductances, dtype=float)  # a copy: the circuit is solved when first read
+    return Circuit(conductances=g, supply_pressure=np.array(np.broadcast_to(supply_pressure, (len(g),)), dtype=float),
+                   bore_area=float(bore_area))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -191,13 +192,15 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
     :func:`twin.friction.coulomb_force` gives it, in the direction it acts.
     """
     n = len(y)
-    f = np.ascontiguousarray
-    static = np.full(n, friction_params.stiction) if breakaway is None else breakaway
+
+    def each(x, dtype=float):  # (n,) contiguous: the compiled loop reads x[i] unchecked
+        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+
+    static = friction_params.stiction if breakaway is None else breakaway
     out, stuck_out = np.empty((6, n)), np.empty(n, dtype=np.bool_)
-    _rack_steps(circuit_now.conductances, circuit_now.supply_pressure, float(bore_area), friction_params.viscous,
-                _coulomb_coefficients(friction_params), *map(float, friction_params.fit_range),
-                friction_params.ccw_coulomb_scale, f(y, dtype=float), f(v0, dtype=float),
-                f(external_force, dtype=float), f(stuck, dtype=np.bool_), f(mass, dtype=float), float(h),
-                f(static, dtype=float), out, stuck_out)
+    _rack_steps(circuit_now.conductances, circuit_now.supply_pressure, float(bore_area),
+                float(friction_params.viscous), _coulomb_coefficients(friction_params),
+                *map(float, friction_params.fit_range), float(friction_params.ccw_coulomb_scale), each(y), each(v0),
+                each(external_force), each(stuck, np.bool_), each(mass), float(h), each(static), out, stuck_out)
     return RackForces(cylinder_a=out[0], cylinder_b=out[1], pressure_a=out[2], pressure_b=out[3],
                       velocity=out[4], force_loss=out[5], stuck=stuck_out)

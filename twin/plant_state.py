@@ -53,18 +53,23 @@ def true_start(scenarios: Sequence[Scenario], reported: np.ndarray) -> np.ndarra
 
 
 def compile_kernels() -> None:
-    """Compile, or load from numba's cache, the per-tick kernels of the valves and the rack step:
-    about 0.3 s the first time in a process (mostly numba starting up). A sweep calls it before
-    forking its workers, so that each inherits them instead of paying again."""
-    from twin.params import NOMINAL_PARAMS
+    """Compile, or load from numba's cache, the per-tick kernels (valves, rack step, compressible
+    chambers): about 0.3 s the first time in a process (mostly numba starting up). A sweep calls it
+    before forking its workers, so that each inherits them instead of paying again."""
+    from twin.params import NOMINAL_PARAMS, ChamberParams
     from twin.valves import ValveModel
 
-    nothing = np.zeros(0)
+    nothing, shut, free = np.zeros(0), np.zeros((0, 4)), np.zeros(0, dtype=bool)
     for model in ValveModel:
         ValveBank(params=NOMINAL_PARAMS.valves, model=model, n=0, tick=1e-3).update(0, nothing)
-    hydraulics.rack_step(circuit_now=hydraulics.circuit(np.zeros((0, 4)), nothing, 1.0),
-                         friction_params=NOMINAL_PARAMS.friction, bore_area=1.0, y=nothing, v0=nothing,
-                         external_force=nothing, stuck=np.zeros(0, dtype=bool), mass=nothing, h=1e-3)
+    hydraulics.rack_step(circuit_now=hydraulics.circuit(shut, nothing, 1.0), friction_params=NOMINAL_PARAMS.friction,
+                         bore_area=1.0, y=nothing, v0=nothing, external_force=nothing, stuck=free, mass=nothing,
+                         h=1e-3)
+    CompressibleCircuit(chambers=ChamberParams(compressible=True), line=NOMINAL_PARAMS.supply_line,
+                        friction_params=NOMINAL_PARAMS.friction, bore_area=1.0, stroke=(0.0, 1.0), supply=nothing,
+                        initial_pressure=nothing).tick(conductance=shut, y=nothing, v0=nothing,
+                                                       external_force=nothing, stuck=free, mass=nothing, h=1e-3,
+                                                       breakaway=np.zeros_like)
 
 
 def place_on_manifold(qpos: np.ndarray, joint: JointModel, y: np.ndarray) -> None:

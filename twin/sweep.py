@@ -53,17 +53,20 @@ def _package_version() -> str:
 
 
 def code_version() -> str:
-    """What a stored row depends on besides its scenario: the package, MuJoCo and NumPy versions,
-    and a hash of every plant preset's parameters and of the MJCF."""
+    """What a stored row depends on besides its scenario: the package, MuJoCo, NumPy and numba
+    versions, and a hash of every plant preset's parameters, the four trajectories and the MJCF."""
     import mujoco
+    import numba
     import numpy as np
 
     from twin.model import MODEL_PATH
+    from twin.params import NOMINAL_PARAMS
     from twin.plants import PLANTS
 
-    params = hashlib.sha256(repr(PLANTS).encode() + MODEL_PATH.read_bytes()).hexdigest()[:16]
+    trajectories = [trajectory(n, spur_radius=NOMINAL_PARAMS.gears.spur_radius) for n in (1, 2, 3, 4)]
+    params = hashlib.sha256(repr((PLANTS, trajectories)).encode() + MODEL_PATH.read_bytes()).hexdigest()[:16]
     return (f"store {STORE_FORMAT}, twin {_package_version()}, mujoco {mujoco.__version__}, "
-            f"numpy {np.__version__}, params {params}")
+            f"numpy {np.__version__}, numba {numba.__version__}, params {params}")
 
 
 def open_store(out: pathlib.Path) -> ResultStore:

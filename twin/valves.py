@@ -88,9 +88,10 @@ class ValveBank:
         """Valve conductances (n, 4) in m^3/(Pa s) at integer ``tick`` for signed ``duty`` (n,) in %."""
         p = self.params
         out = np.empty((self.n, 4))
-        _valve_tick(np.ascontiguousarray(duty, dtype=float), tick, self.duty_steps, self.period_ticks,
-                    self.model is ValveModel.AVERAGED, p.dead_zone_duty, p.resistance_coefficient,
-                    p.resistance_exponent, self.full_conductance, self.open_ticks, self.close_ticks,
+        duty = np.ascontiguousarray(np.broadcast_to(duty, (self.n,)), dtype=float)  # read unchecked when compiled
+        _valve_tick(duty, int(tick), self.duty_steps, self.period_ticks, self.model is ValveModel.AVERAGED,
+                    float(p.dead_zone_duty), float(p.resistance_coefficient), float(p.resistance_exponent),
+                    float(self.full_conductance), self.open_ticks, self.close_ticks,
                     self._on_run, self._off_run, self._open, self._conductance, out)
         return out
 
