@@ -181,3 +181,21 @@ def test_stiction_maps_evaluate_each_runs_own_map():
     assert maps(y)[0] != maps(y)[1]  # two runs, two joints
     with pytest.raises(InvalidParameter, match="needs a seed"):
         StictionMap(params, 2.0, STROKE)
+
+
+def test_run_plot_shows_the_scored_reading_beside_the_true_angle(tmp_path, monkeypatch):
+    """On a plant scored on the Hall reading the figure must show what was scored, not only the true angle."""
+    import matplotlib.figure
+
+    from twin.runner import run
+    from twin.scenario import Scenario
+    from viz.plots import plot_run
+
+    drawn = []
+    monkeypatch.setattr(matplotlib.figure.Figure, "savefig",
+                        lambda fig, path, **kw: drawn.append([[ln.get_label() for ln in ax.lines] for ax in fig.axes]))
+    plot_run(run(Scenario("smc", 1, plant="as-built", seed=0)), tmp_path / "run.png")
+    plot_run(run(Scenario("smc", 1, plant="thesis", seed=0)), tmp_path / "run.png")
+    as_built, thesis = drawn
+    assert "Hall reading" in as_built[0] and "reading (scored)" in as_built[1]
+    assert "Hall reading" not in thesis[0] and len(thesis[1]) == 2  # the true error and the zero line

@@ -28,8 +28,14 @@ def plot_run(result: Result, path: pathlib.Path) -> None:
     axes[0].plot(tr.time, deg(tr.desired_angle), "k--", lw=1.2, label="desired")
     axes[0].plot(tr.time, deg(tr.angle), "C0", lw=1.2, label="actual")
     axes[0].set_ylabel("angle (deg)")
+    axes[1].plot(tr.time, deg(tr.desired_angle - tr.angle), "C3", lw=1.0, label="true")
+    preset = result.scenario.preset
+    if preset.metrics_on_sensor:  # the metrics score the Hall reading, as the thesis's experiments did
+        reading = tr.measured_position / preset.params.gears.spur_radius
+        axes[0].plot(tr.time, deg(reading), "C1", lw=0.8, alpha=0.8, label="Hall reading")
+        axes[1].plot(tr.time, deg(tr.desired_angle - reading), "C1", lw=0.8, alpha=0.8, label="reading (scored)")
+        axes[1].legend(loc="best", fontsize=8)
     axes[0].legend(loc="best")
-    axes[1].plot(tr.time, deg(tr.desired_angle - tr.angle), "C3", lw=1.0)
     axes[1].axhline(0.0, color="0.6", lw=0.6)
     axes[1].set_ylabel("error (deg)")
     m = result.metrics
