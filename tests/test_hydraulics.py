@@ -134,3 +134,10 @@ def test_a_circuit_does_not_follow_later_changes_to_its_inputs():
     c = circuit(g, np.array([P_WS]), AREA)
     g[:] = 0.0
     assert c.drive[0] == pytest.approx(P_WS * AREA, rel=1e-12) and not c.sealed[0]
+
+
+def test_a_per_scenario_input_of_the_wrong_length_is_refused():
+    c = circuit(np.repeat(one(1 / R1, 0.0, 0.0, 1 / R4), 3, axis=0), np.array(P_WS), AREA)
+    with pytest.raises(ValueError, match="one value per scenario"):
+        rack_step(circuit_now=c, friction_params=NO_FRICTION, bore_area=AREA, y=np.full(3, 8e-3), v0=0.0,
+                  external_force=0.0, stuck=False, mass=np.array([0.04, 0.04]), h=H)

@@ -183,3 +183,23 @@ def test_random_valve_commands_raise_no_mujoco_warning(plant):
     assert result.warnings == ()
     assert np.all(np.isfinite(result.trace.angle))
     assert np.max(np.abs(np.degrees(result.trace.coupling_error))) < 0.01
+
+
+def test_a_mujoco_warning_is_reported_on_its_own_scenario_only(monkeypatch):
+    """The smoke test above can only pass if warnings are read: a non-finite piston force in one scenario
+    of a batch must come back as a MuJoCo warning on that scenario and not on its neighbour."""
+    from twin.plant_state import PlantState
+
+    real = PlantState.actuate
+
+    def poisoned(self, k, duty, y, v, external):
+        force_a, force_b = real(self, k, duty, y, v, external)
+        if k == 100:
+            force_a[1] = np.nan
+        return force_a, force_b
+
+    monkeypatch.setattr(PlantState, "actuate", poisoned)
+    scenarios = [Scenario("ffpva", 1, seed=0), Scenario("ffpva", 1, seed=1)]
+    clean, poisoned_run = simulate(scenarios, controllers=thesis_controllers(scenarios))
+    assert clean.warnings == ()
+    assert any(w.startswith("mjWARN_BADCTRL") for w in poisoned_run.warnings), poisoned_run.warnings

@@ -3,15 +3,19 @@
 Reports, for the joint model at the default timestep: a bare ``mj_step`` loop,
 one twin run (n = 1), a batch of many runs (n = 100 by default), and the same
 single run through the dm_control environment, as wall seconds per simulated
-second, with their ratios. Timings on a shared machine are noisy: compare the ratios.
+second, with their ratios. Timings on a shared machine are noisy (other tenants
+slow a run by up to a quarter here): every timing is the fastest of a few
+repeats, the bare loop's and the twin's alike, and only ratios are compared.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import functools
 import os
 import pathlib
 import time
+from collections.abc import Callable
 
 import mujoco
 
@@ -22,9 +26,9 @@ from twin.scenario import Scenario
 
 @dataclasses.dataclass(frozen=True)
 class Bench:
-    bare_step: float  # wall s per simulated s, plain mj_step loop, one MjData
+    bare_step: float  # wall s per simulated s, plain mj_step loop of the joint at rest, one MjData, fastest seen
     twin_single: float  # wall s per simulated s, one twin run
-    twin_batch: float  # wall s per simulated scenario-second, batch of `batch_size`
+    twin_batch: float  # wall s per simulated scenario-second, batch of `batch_size` on one thread
     batch_size: int
     env_single: float  # wall s per simulated s, the dm_control environment, same scenario and policy
     sweep_walls: dict  # workers -> wall s of the same sweep
@@ -35,7 +39,7 @@ class Bench:
             f"bare mj_step:          {self.bare_step * 1e3:8.2f} ms per simulated s",
             f"twin, 1 run:           {self.twin_single * 1e3:8.2f} ms per simulated s "
             f"({self.twin_single / self.bare_step:.1f}x bare)",
-            f"twin, {self.batch_size} runs batched: {self.twin_batch * 1e3:8.2f} ms per simulated scenario-s "
+            f"twin, {self.batch_size} runs batched on one thread: {self.twin_batch * 1e3:8.2f} ms per simulated scenario-s "
             f"({self.twin_batch / self.bare_step:.2f}x bare; {self.twin_batch * self.batch_size * 1e3:.0f} ms "
             f"per simulated s of the whole batch)",
             f"dm_control env, 1 run: {self.env_single * 1e3:8.2f} ms per simulated s "
@@ -50,18 +54,22 @@ class Bench:
         ]
 
 
-def _bare_step_cost(seconds: float, repeats: int = 5) -> float:
-    """The fastest of ``repeats`` bare loops: on a shared machine the minimum is the cost, the rest is
-    other tenants; taking it makes every ratio to it conservative (the twin is timed once)."""
+def _fastest(work: Callable[[], object], repeats: int) -> float:
+    """Wall seconds of the fastest of ``repeats`` calls of ``work``: on a shared machine the minimum is
+    the cost, the rest is other tenants."""
+    walls = []
+    for _ in range(repeats):
+        start = time.perf_counter()
+        work()
+        walls.append(time.perf_counter() - start)
+    return min(walls)
+
+
+def _bare_step_cost(seconds: float) -> float:
+    """A bare ``mj_step`` loop of the joint at rest, per simulated second."""
     joint = compile_joint()
     steps = int(round(seconds / joint.timestep))
-    costs = []
-    for _ in range(repeats):
-        data = mujoco.MjData(joint.model)
-        start = time.perf_counter()
-        mujoco.mj_step(joint.model, data, nstep=steps)
-        costs.append((time.perf_counter() - start) / seconds)
-    return min(costs)
+    return _fastest(lambda: mujoco.mj_step(joint.model, mujoco.MjData(joint.model), nstep=steps), 5) / seconds
 
 
 def _sweep_walls(workers: int) -> tuple[dict, float]:
@@ -76,30 +84,31 @@ def _sweep_walls(workers: int) -> tuple[dict, float]:
     points = expand({"controller": ["pva", "ffpva", "smc"], "trajectory": [1, 2, 3, 4], "payload": [0.0, 6.5, 13.5],
                      "orientation": ["horizontal", "vertical"], "seed": list(range(5))})
     scenario_seconds = sum(trajectory(p.trajectory, spur_radius=1.0).duration for p in points)
-    walls = {}
-    for count in sorted({1, workers}):
+    def sweep(count: int) -> None:
         with tempfile.TemporaryDirectory() as out:
-            start = time.perf_counter()
             run_sweep(points, out=pathlib.Path(out), workers=count)
-            walls[count] = time.perf_counter() - start
-    return walls, scenario_seconds
+
+    return {count: _fastest(functools.partial(sweep, count), 2) for count in sorted({1, workers})}, scenario_seconds
 
 
 def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None) -> Bench:
+    """Each measurement is preceded and the whole followed by a bare loop; the bare cost is the fastest
+    of them all, so a quiet spell during one bare loop cannot flatter the twin."""
     scenario = Scenario("ffpva", trajectory)
-    run_many([scenario])  # warm caches (model compile, imports)
-    start = time.perf_counter()
-    single = run_many([scenario])[0]
+    single = run_many([scenario])[0]  # also warms caches (model compile, imports, kernels)
     duration = float(len(single.trace.time)) * 1e-3
-    twin_single = (time.perf_counter() - start) / duration
+    bare = [_bare_step_cost(duration * 10)]
+    twin_single = _fastest(lambda: run_many([scenario]), 3) / duration
+    bare.append(_bare_step_cost(duration * 10))
     batch = [Scenario("ffpva", trajectory, seed=s) for s in range(batch_size)]
-    start = time.perf_counter()
-    run_many(batch)
-    twin_batch = (time.perf_counter() - start) / (duration * batch_size)
+    twin_batch = _fastest(lambda: run_many(batch, nthread=1), 3) / (duration * batch_size)  # one core, as the bare loop
+    bare.append(_bare_step_cost(duration * 10))
+    env_single = _env_cost(trajectory, duration)
+    bare.append(_bare_step_cost(duration * 10))
     walls, scenario_seconds = _sweep_walls(workers or os.cpu_count() or 1)
-    return Bench(bare_step=_bare_step_cost(duration * 10), twin_single=twin_single,
-                 twin_batch=twin_batch, batch_size=batch_size, env_single=_env_cost(trajectory, duration),
-                 sweep_walls=walls, sweep_scenario_seconds=scenario_seconds)
+    bare.append(_bare_step_cost(duration * 10))
+    return Bench(bare_step=min(bare), twin_single=twin_single, twin_batch=twin_batch, batch_size=batch_size,
+                 env_single=env_single, sweep_walls=walls, sweep_scenario_seconds=scenario_seconds)
 
 
 def _env_cost(trajectory: int, duration: float) -> float:
@@ -111,9 +120,11 @@ def _env_cost(trajectory: int, duration: float) -> float:
 
     controller = make_controller("ffpva", nominal=NominalModel.thesis(), gain_set="simulation", tick=1e-3)
     environment = joint_env.load("track", trajectory=trajectory, seed=0)
-    start = time.perf_counter()
-    timestep = environment.reset()
-    policy = ControllerPolicy(controller, spur_radius=environment.physics.spur_radius)
-    while not timestep.last():
-        timestep = environment.step(policy(timestep))
-    return (time.perf_counter() - start) / duration
+
+    def episode() -> None:
+        timestep = environment.reset()
+        policy = ControllerPolicy(controller, spur_radius=environment.physics.spur_radius)
+        while not timestep.last():
+            timestep = environment.step(policy(timestep))
+
+    return _fastest(episode, 3) / duration

@@ -48,6 +48,7 @@ import numba
 import numpy as np
 
 from twin.params import FrictionParams
+from twin.scenario_axis import per_scenario
 
 
 @numba.njit(cache=True)
@@ -108,7 +109,7 @@ class Circuit:
 def circuit(conductances: np.ndarray, supply_pressure: np.ndarray, bore_area: float) -> Circuit:
     """The valve network; ``conductances`` (n, 4) for V1..V4, pressure (n,) in Pa."""
     g = np.array(conductances, dtype=float)  # a copy: the circuit is solved when first read
-    return Circuit(conductances=g, supply_pressure=np.array(np.broadcast_to(supply_pressure, (len(g),)), dtype=float),
+    return Circuit(conductances=g, supply_pressure=np.array(per_scenario(supply_pressure, len(g))),
                    bore_area=float(bore_area))
 
 
@@ -194,7 +195,7 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
     n = len(y)
 
     def each(x, dtype=float):  # (n,) contiguous: the compiled loop reads x[i] unchecked
-        return np.ascontiguousarray(np.broadcast_to(x, (n,)), dtype=dtype)
+        return per_scenario(x, n, dtype)
 
     static = friction_params.stiction if breakaway is None else breakaway
     out, stuck_out = np.empty((6, n)), np.empty(n, dtype=np.bool_)

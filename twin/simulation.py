@@ -73,13 +73,9 @@ def _joint(params: JointParams, payload: float, orientation: Orientation, timest
     return compile_joint(params=params, payload_mass=payload, orientation=orientation, timestep=timestep)
 
 
-def _warnings(data: mujoco.MjData) -> tuple[str, ...]:
-    found = []
-    for index in range(int(mujoco.mjtWarning.mjNWARNING)):
-        count = data.warning[index].number
-        if count:
-            found.append(f"{mujoco.mjtWarning(index).name} x{count}")
-    return tuple(found)
+def _warnings(counts: np.ndarray) -> tuple[str, ...]:
+    """Names and counts of the warnings raised, from one simulation's counters (mjNWARNING,)."""
+    return tuple(f"{mujoco.mjtWarning(index).name} x{count}" for index, count in enumerate(counts) if count)
 
 
 def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller],
@@ -116,7 +112,11 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     lengths = np.array([whole_ticks(tr.duration, h, what="trajectory") for tr in trajectories])
     ticks = int(lengths.max())
     t = np.arange(ticks) * h
-    references = [tr.sample(t, r) for tr, r in zip(trajectories, spur_radius, strict=True)]
+    sampled: dict = {}  # scenarios of one trajectory and gearing share their reference
+    for tr, r in zip(trajectories, spur_radius, strict=True):
+        if (tr, r) not in sampled:
+            sampled[tr, r] = tr.sample(t, r)
+    references = [sampled[tr, r] for tr, r in zip(trajectories, spur_radius, strict=True)]
     y_d = np.stack([ref.position for ref in references])
     v_d = np.stack([ref.velocity for ref in references])
     a_d = np.stack([ref.acceleration for ref in references])
@@ -177,13 +177,14 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
             progress(k + 1, ticks)
 
     wall = time.perf_counter() - started
+    warning_counts = batch.warning[:, :, 1]  # (n, mjNWARNING): mjWarningStat.number of every simulation
     results = []
     for i, s in enumerate(scenarios):
         T = lengths[i]
         series = {name: rec[name][:T, i].copy() for name in rec}  # contiguous per run
         theta = series["theta"]
         desired = y_d[i, :T] / spur_radius[i]
-        warnings = _warnings(batch.get_data(i))
+        warnings = _warnings(warning_counts[i])
         if i in failures:
             warnings += (failures[i],)
         if not np.all(np.isfinite(theta)):

@@ -40,6 +40,7 @@ import numpy as np
 
 from twin.exceptions import InvalidScenario
 from twin.params import ValveParams
+from twin.scenario_axis import per_scenario
 from twin.ticks import whole_ticks
 
 SUPPLY_A, DRAIN_A, SUPPLY_B, DRAIN_B = range(4)  # V1, V2, V3, V4
@@ -88,7 +89,7 @@ class ValveBank:
         """Valve conductances (n, 4) in m^3/(Pa s) at integer ``tick`` for signed ``duty`` (n,) in %."""
         p = self.params
         out = np.empty((self.n, 4))
-        duty = np.ascontiguousarray(np.broadcast_to(duty, (self.n,)), dtype=float)  # read unchecked when compiled
+        duty = per_scenario(duty, self.n)  # read unchecked when compiled
         _valve_tick(duty, int(tick), self.duty_steps, self.period_ticks, self.model is ValveModel.AVERAGED,
                     float(p.dead_zone_duty), float(p.resistance_coefficient), float(p.resistance_exponent),
                     float(self.full_conductance), self.open_ticks, self.close_ticks,
