@@ -282,3 +282,13 @@ def test_feedforward_accounts_for_the_desired_acceleration():
     accelerating = feedforward_duty(model, np.array([y]), np.array([v]), np.array([a]))[0]
     cruising = feedforward_duty(model, np.array([y]), np.array([v]), np.array([0.0]))[0]
     assert accelerating > cruising  # more force needed: less resistance, more duty
+
+
+def test_a_contiguous_run_of_scenarios_is_selected_by_a_slice_and_others_by_their_indices():
+    from twin.scenario_axis import selector
+
+    assert selector(np.array([3, 4, 5])) == slice(3, 6)
+    gappy = selector(np.array([0, 2, 3]))
+    assert isinstance(gappy, np.ndarray) and gappy.tolist() == [0, 2, 3]
+    values = np.arange(10.0)
+    assert values[selector(np.array([3, 4, 5]))].tolist() == values[[3, 4, 5]].tolist()

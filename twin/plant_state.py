@@ -28,6 +28,7 @@ from twin.hall import HallReading
 from twin.model import JointModel
 from twin.plants import Plant
 from twin.scenario import Scenario
+from twin.scenario_axis import selector
 from twin.sensing import FirstOrderObserver, uniform_noise
 from twin.stiction_map import StictionMaps
 from twin.valves import ValveBank
@@ -155,7 +156,7 @@ class PlantState:
         """Piston forces (cylinder A, cylinder B) in N for the duty command (n,) in %."""
         force_a, force_b = np.zeros(self.n), np.zeros(self.n)
         for group in self._plant_groups:
-            idx, params = group.idx, group.preset.params
+            idx, params = group.selector, group.preset.params
             self.conductance[idx] = group.valves.update(k, duty[idx])
             area = params.cylinder.bore_area
             if group.chambers is None:
@@ -185,6 +186,7 @@ class _PlantGroup:
                  supply: np.ndarray, scenarios: Sequence[Scenario]):
         params = preset.params
         self.preset, self.idx = preset, idx
+        self.selector = selector(idx)  # idx, for indexing every tick
         self.valves = ValveBank(params=params.valves, model=preset.valve_model, n=len(idx), tick=tick)
         map_seeds = [params.stiction_map.seed if params.stiction_map.seed is not None else (s.seed, 1)
                      for s in scenarios]  # (seed, 1): the map's stream, apart from the noise's

@@ -33,6 +33,7 @@ from twin.params import JointParams
 from twin.plant_state import PlantState, groups, place_on_manifold, true_start
 from twin.plants import Plant
 from twin.scenario import Scenario
+from twin.scenario_axis import selector
 from twin.ticks import whole_ticks
 from twin.trajectories import trajectory
 
@@ -134,7 +135,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     for _, idx in groups([id(c) for c in controllers]).items():
         controller = controllers[idx[0]]
         controller.reset(len(idx))
-        controller_groups.append((controller, idx, whole_ticks(controller.period, h, what="controller period")))
+        controller_groups.append((controller, selector(idx), whole_ticks(controller.period, h, what="controller period")))
 
     duty = np.zeros(n)
     failures: dict[int, str] = {}
