@@ -160,3 +160,21 @@ def test_demo_writes_results_and_summary(tmp_path):
     assert len(header) == 2  # the comparison table and T4's rest errors
     assert "RMSE" in header[0] and "T4 rest errors" in header[1]
     assert not list(out.glob("*.png"))  # --no-plots
+
+
+def test_without_switches_off_as_built_effects_by_name(tmp_path):
+    full = run_json(tmp_path, "--plant", "as-built", "--seed", "0")
+    ablated = run_json(tmp_path, "--plant", "as-built", "--seed", "0", "--without", "stiction,dead_zone")
+    assert ablated["plant"] == "as-built-without-dead_zone+stiction"
+    assert ablated["rmse_deg"] != full["rmse_deg"]
+
+
+@pytest.mark.parametrize("args, bad", [
+    (["--plant", "as-built", "--without", "friction"], "friction"),
+    (["--plant", "thesis", "--without", "dead_zone"], "'thesis'"),
+    (["--plant", "as-built", "--without", "compressibility"], "supply_line off too"),
+])
+def test_without_refuses_what_it_cannot_switch_off(tmp_path, args, bad):
+    proc = twin(tmp_path, *BASE, *args, "--json")
+    assert proc.returncode == 2
+    assert bad in proc.stderr and len(proc.stderr.strip().splitlines()) == 1 and proc.stdout == ""

@@ -104,8 +104,8 @@ def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) ->
         raise InvalidScenario(f"unknown as-built effects {sorted(unknown)}: choose from {', '.join(EFFECTS)}")
     on = set(EFFECTS) - off
     if "supply_line" in on and "compressibility" not in on:
-        raise InvalidScenario("the supply line is integrated with the compressible chambers: "
-                              "switch compressibility on with it")
+        raise InvalidScenario("the supply line is integrated with the compressible chambers: switch "
+                              "compressibility on with it, or switch supply_line off too")
     from twin.plants import THESIS_PARAMS as base  # twin.plants registers this plant: import late
     friction = dataclasses.replace(
         base.friction,

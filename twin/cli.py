@@ -21,9 +21,10 @@ import signal
 import sys
 import time
 
-from twin.exceptions import TwinError
+from twin.as_built import EFFECTS, as_built_plant
+from twin.exceptions import InvalidScenario, TwinError
 from twin.model import Orientation
-from twin.plants import PLANTS
+from twin.plants import PLANTS, Plant
 from twin.scenario import CONTROLLER_NAMES, Scenario
 
 EXIT_USAGE = 2
@@ -85,12 +86,33 @@ def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
                         help="the thesis's sensor noise, seeded (default on)")
     parser.add_argument("--supply-kpa", type=_kpa, default=None, help="supply pressure (kPa gauge)")
+    parser.add_argument("--without", type=_effects, default=(), metavar="EFFECT[,EFFECT]",
+                        help=f"as-built effects to switch off ({', '.join(EFFECTS)}); only with --plant as-built")
+
+
+def _effects(text: str) -> tuple[str, ...]:
+    names = tuple(sorted({name.strip() for name in text.split(",") if name.strip()}))
+    unknown = [name for name in names if name not in EFFECTS]
+    if not names or unknown:
+        raise argparse.ArgumentTypeError(f"unknown as-built effect {', '.join(unknown) or repr(text)}: "
+                                         f"choose from {', '.join(EFFECTS)}")
+    return names
+
+
+def _plant_of(args: argparse.Namespace) -> str | Plant:
+    """``--plant``, or the as-built plant with the ``--without`` effects switched off."""
+    if not args.without:
+        return args.plant
+    if args.plant != "as-built":
+        raise InvalidScenario(f"--without switches off as-built effects, but the plant is {args.plant!r}: "
+                              f"use --plant as-built")
+    return as_built_plant(without=args.without, name="as-built-without-" + "+".join(args.without))
 
 
 def scenario_from(args: argparse.Namespace) -> Scenario:
     return Scenario(
         controller=args.controller, trajectory=args.trajectory, payload=args.payload / 1e3,
-        orientation=Orientation(args.orientation), plant=args.plant, seed=args.seed, noise=args.noise,
+        orientation=Orientation(args.orientation), plant=_plant_of(args), seed=args.seed, noise=args.noise,
         supply_pressure=None if args.supply_kpa is None else args.supply_kpa * 1e3,
     )
 
