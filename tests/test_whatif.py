@@ -137,3 +137,42 @@ def test_whatif_rejects_a_bad_list_naming_its_flag_and_writes_nothing(tmp_path, 
     assert main(["whatif", study, flag, value, "--out", str(out)]) == 2
     assert flag in capsys.readouterr().err
     assert not out.exists()
+
+
+def test_supply_variants_differ_in_the_supply_alone_and_sag_as_their_compliance_says():
+    """The constant supply holds 300 kPa exactly; the line sags while water flows; the accumulator's extra
+    compliance at the valve block makes the same flow sag it less (the line's dip scales with sqrt(L / C))."""
+    import dataclasses
+
+    from twin.plants import plant
+    from twin.runner import run_many
+    from twin.scenario import Scenario
+    from twin.whatif import SUPPLY_MODELS, supply_variants
+
+    base = plant("as-built")
+    variants = supply_variants(base)
+    assert tuple(variants) == SUPPLY_MODELS
+    for model, variant in variants.items():
+        assert dataclasses.replace(variant.params, supply_line=base.params.supply_line) == base.params
+        assert variant.params.supply_line.model == model
+    traces = {m: r.trace for m, r in zip(SUPPLY_MODELS, run_many(
+        [Scenario("ffpva", 1, plant=variants[m], seed=0, noise=False) for m in SUPPLY_MODELS]), strict=True)}
+    assert np.all(traces["constant"].supply_pressure == 300e3)
+    line_dip = 300e3 - traces["line"].supply_pressure.min()
+    accumulator_dip = 300e3 - traces["accumulator"].supply_pressure.min()
+    assert 0 < accumulator_dip < line_dip
+
+
+def test_whatif_supply_writes_its_answer_and_refuses_a_plant_with_a_constant_supply(tmp_path, capsys):
+    out = tmp_path / "supply"
+    assert main(["whatif", "supply", "--seeds", "1", "--out", str(out)]) == 0
+    for suffix in (".csv", ".png", ".txt"):
+        assert (out / f"supply{suffix}").stat().st_size > 0
+    with open(out / "supply.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert sorted({r["supply_model"] for r in rows}) == ["accumulator", "constant", "line"]
+    assert len(rows) == 3 * 2 * 2  # supply models x controllers x trajectories (T1, T3)
+    assert "ffpva T3: line" in (out / "supply.txt").read_text()
+    never = tmp_path / "never"
+    assert main(["whatif", "supply", "--plant", "thesis", "--out", str(never)]) == 2
+    assert "holds its supply constant" in capsys.readouterr().err and not never.exists()

@@ -293,6 +293,10 @@ def _cmd_whatif(args: argparse.Namespace) -> int:
 
     plant_name = args.plant or whatif.DEFAULT_PLANTS[args.study]
     values = _whatif_values(args, plant_name)
+    if args.study == "supply":  # a plant whose supply cannot sag is refused before anything is written
+        from twin.plants import plant
+
+        whatif.supply_variants(plant(plant_name))
     args.out.mkdir(exist_ok=True)
     with tqdm(unit="scenario", file=sys.stderr, dynamic_ncols=True, desc=args.study) as bar:
         if args.study == "payload":
@@ -304,6 +308,8 @@ def _cmd_whatif(args: argparse.Namespace) -> int:
             study = whatif.pwm_study(periods_ms=values, seeds=args.seeds, plant_name=plant_name)
         elif args.study == "lift":
             study = whatif.lift_study(pressures_kpa=values, plant_name=plant_name)
+        elif args.study == "supply":
+            study = whatif.supply_study(seeds=args.seeds, plant_name=plant_name)
         else:
             study = whatif.gear_load_study(plant_name=plant_name)
     stem = args.out / args.study
@@ -381,8 +387,8 @@ def build_parser() -> argparse.ArgumentParser:
     sweep.add_argument("--ray-address", default=None, help="Ray cluster address (default: RAY_ADDRESS or local)")
     sweep.set_defaults(func=_cmd_sweep)
 
-    whatif = sub.add_parser("whatif", help="payload, lift, PWM and gear-load studies")
-    whatif.add_argument("study", choices=("payload", "lift", "pwm", "gear-load"))
+    whatif = sub.add_parser("whatif", help="payload, lift, PWM, gear-load and supply studies")
+    whatif.add_argument("study", choices=("payload", "lift", "pwm", "gear-load", "supply"))
     whatif.add_argument("--out", type=_out_dir, required=True, metavar="DIR")
     whatif.add_argument("--plant", choices=sorted(PLANTS), default=None,
                         help="default: thesis-pwm for pwm (switching valves), thesis otherwise")

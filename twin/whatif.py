@@ -13,6 +13,10 @@ pwm        tracking against the valves' PWM period alone (SPEC §10), on the
 gear-load  gear tooth forces, from the couplings' constraint forces, against
            the Lewis safe loads at the pitch-line speed of the moment, over
            several averaging windows (single 1 ms ticks are impacts).
+supply     tracking on the as-built plant with its air-over-water supply line,
+           with a gas accumulator at the valve block instead (SPEC §10, future
+           work 1), and with an ideal constant supply: how much the sagging,
+           ringing supply costs, and how much an accumulator buys back.
 """
 
 from __future__ import annotations
@@ -24,6 +28,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from twin import friction, report
+from twin.exceptions import InvalidScenario
 from twin.gears import lewis_safe_load
 from twin.grid import expand
 from twin.model import Orientation
@@ -42,7 +47,9 @@ THESIS_PAYLOAD = 13.5e-3  # kg
 PWM_CONTROLLERS = ("ffpva", "smc")
 AVERAGING_WINDOWS = (1e-3, 2e-3, 5e-3, 10e-3, 20e-3)  # s, moving averages of the tooth forces
 SUSTAINED_WINDOW = 10e-3  # s: averaging window separating sustained loads from one-step impacts
-DEFAULT_PLANTS = {"payload": "thesis", "lift": "thesis", "pwm": "thesis-pwm", "gear-load": "thesis"}
+DEFAULT_PLANTS = {"payload": "thesis", "lift": "thesis", "pwm": "thesis-pwm", "gear-load": "thesis",
+                  "supply": "as-built"}
+SUPPLY_MODELS = ("line", "accumulator", "constant")  # SupplyLineParams.model, the plant's own first
 
 
 @dataclasses.dataclass(frozen=True)
@@ -273,3 +280,43 @@ def gear_load_study(*, pressures_kpa: Sequence[float] = (300.0, 700.0), payloads
               "1 ms step, so single-tick peaks are impacts whose size scales with 1/timestep; the sustained "
               "(averaged) loads are the meaningful ones until the plant has compliance (issue: as-built plant).")
     return Study("gear-load", rows, answer)
+
+
+# --- supply ---------------------------------------------------------------------------------------------------
+
+def supply_variants(base: Plant) -> dict[str, Plant]:
+    """``base`` with each supply model of :data:`SUPPLY_MODELS`, named after it."""
+    if not base.params.chambers.compressible:
+        raise InvalidScenario(f"the supply study needs a plant whose supply can sag (compressible chambers, as "
+                              f"as-built): {base.name!r} holds its supply constant")
+    return {model: dataclasses.replace(base, name=f"{base.name}, {model} supply", params=dataclasses.replace(
+        base.params, supply_line=dataclasses.replace(base.params.supply_line, model=model)))
+        for model in SUPPLY_MODELS}
+
+
+def supply_study(*, trajectories: Sequence[int] = (1, 3), seeds: int = 3, plant_name: str = DEFAULT_PLANTS["supply"],
+                 progress=None) -> Study:
+    """FF + PVA and sliding mode on ``trajectories`` with each supply model, ``seeds`` runs each, one batch."""
+    from twin.runner import run_many
+
+    variants = supply_variants(plant(plant_name))
+    cases = [(Scenario(c, t, plant=variants[m], seed=s), m)
+             for m in SUPPLY_MODELS for c in PWM_CONTROLLERS for t in trajectories for s in range(seeds)]
+    results = run_many([s for s, _ in cases], progress=progress)
+    records = [{**report.summary(r), "pwm_period_ms": None, "status": "failed" if r.warnings else "ok"}
+               for r in results]
+    model_of = {variant.name: model for model, variant in variants.items()}
+    rows = [{"supply_model": model_of[row["plant"]], **row} for row in summarise(records)]
+    line = variants["line"].params.supply_line
+    lines = [f"{plant_name} plant, supply through a hose ringing at {line.natural_frequency:g} Hz (line), the same with "
+             f"a {line.accumulator_compliance:.0e} m^3/Pa gas accumulator at the valve block (accumulator), and a "
+             f"constant {THESIS_SUPPLY / 1e3:g} kPa (constant); mean RMSE over {seeds} seeds:"]
+    for controller in PWM_CONTROLLERS:
+        for t in trajectories:
+            by_model = {r["supply_model"]: r for r in rows if r["controller"] == controller and r["trajectory"] == t}
+            line_rmse = by_model["line"]["rmse_mean_deg"]
+            lines.append(f"{controller} T{t}: " + ", ".join(
+                f"{m} {by_model[m]['rmse_mean_deg']:.2f} deg ({by_model[m]['rmse_mean_deg'] / line_rmse - 1:+.0%}"
+                + ("" if np.isnan(by_model[m]["sse_mean_deg"]) else f", SSE {by_model[m]['sse_mean_deg']:+.2f}")
+                + ")" for m in SUPPLY_MODELS))
+    return Study("supply", rows, "\n".join(lines))

@@ -10,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from twin.whatif import AVERAGING_WINDOWS, SUSTAINED_WINDOW, window_label  # noqa: E402
+from twin.whatif import AVERAGING_WINDOWS, SUPPLY_MODELS, SUSTAINED_WINDOW, window_label  # noqa: E402
 from viz.sweep_plots import plot_summary  # noqa: E402
 
 
@@ -64,4 +64,20 @@ def plot_gear_load(rows: Sequence[dict], path: pathlib.Path) -> None:
     _finish(fig, ax, path, xlabel="run", ylabel="tooth force / Lewis safe load at that tick")
 
 
-PLOTS = {"payload": plot_summary, "lift": plot_lift, "pwm": plot_pwm, "gear-load": plot_gear_load}
+def plot_supply(rows: Sequence[dict], path: pathlib.Path) -> None:
+    """RMSE (mean and std over seeds) per controller and trajectory, one bar per supply model."""
+    fig, ax = plt.subplots(figsize=(7, 4.5), constrained_layout=True)
+    cases = sorted({(r["controller"], r["trajectory"]) for r in rows})
+    width = 0.8 / len(SUPPLY_MODELS)
+    for j, model in enumerate(SUPPLY_MODELS):
+        by_case = {(r["controller"], r["trajectory"]): r for r in rows if r["supply_model"] == model}
+        ax.bar([i + (j - (len(SUPPLY_MODELS) - 1) / 2) * width for i in range(len(cases))],
+               [by_case[c]["rmse_mean_deg"] for c in cases], width, yerr=[by_case[c]["rmse_std_deg"] for c in cases],
+               capsize=3, label=f"{model} supply")
+    ax.set_xticks(range(len(cases)), [f"{controller} T{trajectory}" for controller, trajectory in cases])
+    ax.set_title(f"{rows[0]['plant'].split(',')[0]} plant: supply line, accumulator, ideal supply", fontsize=9)
+    _finish(fig, ax, path, xlabel="controller and trajectory", ylabel="RMSE (deg)")
+
+
+PLOTS = {"payload": plot_summary, "lift": plot_lift, "pwm": plot_pwm, "gear-load": plot_gear_load,
+         "supply": plot_supply}
