@@ -115,13 +115,18 @@ def test_whatif_cli_writes_table_plot_and_answer(tmp_path):
     assert {"spur_peak_1ms_n", "spur_peak_10ms_n", "pinion_lewis_at_worst_10ms_n"} <= set(header)
 
 
+def _whatif_rows(out: pathlib.Path, study: str, *args: str) -> list[dict]:
+    """Run ``twin whatif study`` into ``out``; check it wrote its CSV, plot and answer; the CSV's rows."""
+    assert main(["whatif", study, *args, "--out", str(out)]) == 0
+    for suffix in (".csv", ".png", ".txt"):
+        assert (out / f"{study}{suffix}").stat().st_size > 0
+    with open(out / f"{study}.csv") as handle:
+        return list(csv.DictReader(handle))
+
+
 def test_whatif_lift_cli_writes_sorted_rows_and_says_what_it_did_not_study(tmp_path, capsys):
     out = tmp_path / "lift"
-    assert main(["whatif", "lift", "--pressures", "150,100", "--out", str(out)]) == 0
-    for suffix in (".csv", ".png", ".txt"):
-        assert (out / f"lift{suffix}").stat().st_size > 0
-    with open(out / "lift.csv") as handle:
-        rows = list(csv.DictReader(handle))
+    rows = _whatif_rows(out, "lift", "--pressures", "150,100")
     assert [float(r["supply_kpa"]) for r in rows] == [100.0, 150.0]
     assert all(float(r["lift_simulated_g"]) == 0.0 for r in rows)  # neither lifts the bare link
     answer = (out / "lift.txt").read_text()
@@ -165,11 +170,7 @@ def test_supply_variants_differ_in_the_supply_alone_and_sag_as_their_compliance_
 
 def test_whatif_supply_writes_its_answer_and_refuses_a_plant_with_a_constant_supply(tmp_path, capsys):
     out = tmp_path / "supply"
-    assert main(["whatif", "supply", "--seeds", "1", "--out", str(out)]) == 0
-    for suffix in (".csv", ".png", ".txt"):
-        assert (out / f"supply{suffix}").stat().st_size > 0
-    with open(out / "supply.csv") as handle:
-        rows = list(csv.DictReader(handle))
+    rows = _whatif_rows(out, "supply", "--seeds", "1")
     assert sorted({r["supply_model"] for r in rows}) == ["accumulator", "constant", "line"]
     assert len(rows) == 3 * 2 * 2  # supply models x controllers x trajectories (T1, T3)
     assert "ffpva T3: line" in (out / "supply.txt").read_text()
