@@ -54,7 +54,8 @@ class ValveModel(enum.Enum):
 class ValveBank:
     """Four valves for each of ``n`` scenarios; call :meth:`update` once per tick.
 
-    State: the coil conductance history (n, 4, n_open + 1) in m^3/(Pa s).
+    State, (n, 4) arrays updated in place every tick: how many ticks each coil has been on and off,
+    whether each valve is open, and each coil's latest conductance in m^3/(Pa s).
     """
 
     def __init__(self, *, params: ValveParams, model: ValveModel, n: int, tick: float):
