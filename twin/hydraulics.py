@@ -47,6 +47,7 @@ import functools
 import numba
 import numpy as np
 
+from twin import friction
 from twin.params import FrictionParams
 from twin.scenario_axis import per_scenario
 
@@ -127,21 +128,11 @@ class RackForces:
 
 
 @numba.njit(cache=True)
-def _coulomb(poly, low, high, ccw_scale, y, direction):  # pragma: no cover - compiled
-    """twin.friction.coulomb_force for one scenario (Horner, as np.polyval)."""
-    clamped = min(max(y, low), high)
-    magnitude = 0.0
-    for c in poly:
-        magnitude = magnitude * clamped + c
-    magnitude = max(magnitude, 0.0)
-    return ccw_scale * magnitude if direction < 0 else magnitude
-
-
-@numba.njit(cache=True)
-def _rack_steps(conductances, supply, area, viscous, poly, low, high, ccw_scale, y, v0, external, stuck, mass, h,
+def _rack_steps(conductances, supply, area, viscous, forward, backward, v0, external, stuck, mass, h,
                 breakaway, out, stuck_out):  # pragma: no cover - compiled
-    """:func:`rack_step` for every scenario; ``out`` rows: cylinder A, cylinder B, P_a, P_b, v1, loss."""
-    for i in range(y.shape[0]):
+    """:func:`rack_step` for every scenario; ``forward``/``backward`` the Coulomb force moving towards
+    +y / -y; ``out`` rows: cylinder A, cylinder B, P_a, P_b, v1, loss."""
+    for i in range(v0.shape[0]):
         g1, g2, g3, g4 = conductances[i, 0], conductances[i, 1], conductances[i, 2], conductances[i, 3]
         drive, damping, idle_a, idle_b = _network(g1, g2, g3, g4, supply[i], area)
         g_a, g_b = g1 + g2, g3 + g4
@@ -149,7 +140,7 @@ def _rack_steps(conductances, supply, area, viscous, poly, low, high, ccw_scale,
         c_h = 0.0 if sealed else damping
         # Friction force that would stop the rack in this step (damping vanishes at v1 = 0).
         to_stop = -(mass[i] * v0[i] / h + drive + external[i])
-        coulomb = _coulomb(poly, low, high, ccw_scale, y[i], -np.sign(to_stop))
+        coulomb = backward[i] if to_stop > 0 else forward[i]  # friction opposes what to_stop resists
         limit = max(coulomb, breakaway[i]) if stuck[i] else coulomb
         sticks = sealed or abs(to_stop) <= limit
         if sealed:
@@ -175,11 +166,6 @@ def _rack_steps(conductances, supply, area, viscous, poly, low, high, ccw_scale,
         stuck_out[i] = sticks
 
 
-@functools.lru_cache(maxsize=16)
-def _coulomb_coefficients(params: FrictionParams) -> np.ndarray:
-    return np.array(params.coulomb_poly, dtype=float)
-
-
 def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_area: float,
               y: np.ndarray, v0: np.ndarray, external_force: np.ndarray, stuck: np.ndarray,
               mass: np.ndarray, h: float, breakaway: np.ndarray | None = None) -> RackForces:
@@ -198,10 +184,11 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
         return per_scenario(x, n, dtype)
 
     static = friction_params.stiction if breakaway is None else breakaway
+    forward = each(friction.coulomb_force(friction_params, y, np.ones(n)))  # eq. 4.5.7, towards +y
+    backward = forward * friction_params.ccw_coulomb_scale  # towards 0 deg, as coulomb_force scales it
     out, stuck_out = np.empty((6, n)), np.empty(n, dtype=np.bool_)
     _rack_steps(circuit_now.conductances, circuit_now.supply_pressure, float(bore_area),
-                float(friction_params.viscous), _coulomb_coefficients(friction_params),
-                *map(float, friction_params.fit_range), float(friction_params.ccw_coulomb_scale), each(y), each(v0),
-                each(external_force), each(stuck, np.bool_), each(mass), float(h), each(static), out, stuck_out)
+                float(friction_params.viscous), forward, backward, each(v0), each(external_force),
+                each(stuck, np.bool_), each(mass), float(h), each(static), out, stuck_out)
     return RackForces(cylinder_a=out[0], cylinder_b=out[1], pressure_a=out[2], pressure_b=out[3],
                       velocity=out[4], force_loss=out[5], stuck=stuck_out)
