@@ -174,6 +174,17 @@ def test_coulomb_force_is_clamped_outside_the_fitted_range():
     assert _fc(30e-3)[0] == pytest.approx(max(f_c_by_hand(14.5e-3), 0.0), rel=1e-9, abs=1e-12)
 
 
+def test_coulomb_force_broadcasts_and_scales_only_towards_zero_degrees():
+    params = FrictionParams(ccw_coulomb_scale=1.4)
+    y = np.array([3e-3, 8e-3, 12.5e-3])
+    grid = coulomb_force(params, y[:, None], np.array([1.0, -1.0, 0.0]))  # (3, 1) against (3,)
+    assert grid.shape == (3, 3)
+    assert grid[:, 0] == pytest.approx([max(f_c_by_hand(v), 0.0) for v in y], rel=1e-9, abs=1e-12)
+    assert grid[:, 1] == pytest.approx(1.4 * grid[:, 0], rel=1e-12)  # moving towards 0 deg
+    assert np.all(grid[:, 2] == grid[:, 0])  # at rest: the fitted value, unscaled
+    assert float(coulomb_force(params, 8e-3, -1.0)) == pytest.approx(grid[1, 1], rel=1e-12)
+
+
 def test_coulomb_force_is_never_negative():
     y = np.linspace(-10e-3, 30e-3, 4001)
     assert np.all(_fc(y) >= 0.0)

@@ -23,6 +23,9 @@ from twin.model import compile_joint
 from twin.runner import run_many
 from twin.scenario import Scenario
 
+REPEATS = 4  # of every twin timing; the bare loop is timed 5 times before and after each (here, a run
+# slows by up to a quarter at random: the fastest of a few is the cost)
+
 
 @dataclasses.dataclass(frozen=True)
 class Bench:
@@ -89,7 +92,7 @@ def _sweep_walls(workers: int) -> tuple[dict, float]:
         with tempfile.TemporaryDirectory() as out:
             run_sweep(points, out=pathlib.Path(out), workers=count)
 
-    return {count: _fastest(functools.partial(sweep, count), 2) for count in sorted({1, workers})}, scenario_seconds
+    return {count: _fastest(functools.partial(sweep, count), REPEATS) for count in sorted({1, workers})}, scenario_seconds
 
 
 def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None) -> Bench:
@@ -99,10 +102,10 @@ def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None =
     single = run_many([scenario])[0]  # also warms caches (model compile, imports, kernels)
     duration = float(len(single.trace.time)) * 1e-3
     bare = [_bare_step_cost(duration * 10)]
-    twin_single = _fastest(lambda: run_many([scenario]), 3) / duration
+    twin_single = _fastest(lambda: run_many([scenario]), REPEATS) / duration
     bare.append(_bare_step_cost(duration * 10))
     batch = [Scenario("ffpva", trajectory, seed=s) for s in range(batch_size)]
-    twin_batch = _fastest(lambda: run_many(batch, nthread=1), 3) / (duration * batch_size)  # one core, as the bare loop
+    twin_batch = _fastest(lambda: run_many(batch, nthread=1), REPEATS) / (duration * batch_size)  # one core, as the bare loop
     bare.append(_bare_step_cost(duration * 10))
     env_single = _env_cost(trajectory, duration)
     bare.append(_bare_step_cost(duration * 10))
@@ -128,4 +131,4 @@ def _env_cost(trajectory: int, duration: float) -> float:
         while not timestep.last():
             timestep = environment.step(policy(timestep))
 
-    return _fastest(episode, 3) / duration
+    return _fastest(episode, REPEATS) / duration

@@ -36,7 +36,8 @@ alone after the constraint solve and tears the couplings apart.
 The network and the step run as one compiled loop over the scenarios (numba):
 as numpy they were ~80 array calls per tick, as much as MuJoCo's own step for a
 batch of 90. The loop does the same float operations in the same order as the
-numpy form did, so the numbers did not change (checked bit for bit).
+numpy form did, so the numbers did not change (checked bit for bit). The
+Coulomb force of eq. 4.5.7 comes in from :mod:`twin.friction`, its one home.
 """
 
 from __future__ import annotations
