@@ -2,7 +2,7 @@
 
 Chambers (§3): pressure build-up through one valve, the hydraulic natural
 frequency of two sealed chambers. Friction (§4): breakaway at the mapped
-stiction, direction-dependent Coulomb friction. Supply line (§3): step
+stiction, direction-dependent Coulomb friction, the held supply valve's creep. Supply line (§3): step
 recovery and steady sag of the L-R-C line, the accumulator's slower recovery.
 Then the whole plant: a 200-sub-step reference, all effects off is the thesis
 plant exactly, every effect's switch is wired, and the Hall reading in the loop.
@@ -40,7 +40,8 @@ G_OPEN = 1.0 / ValveParams().open_resistance  # m^3/(Pa s), a valve fully on (eq
 FRICTIONLESS = FrictionParams(viscous=0.0, coulomb_poly=(0.0,), stiction=0.0)
 CONSTANT_SUPPLY = SupplyLineParams()  # the thesis's P_s = P_0
 THESIS_FRICTION = FrictionParams(stiction=0.0)  # eq. 4.5.5 with eq. 4.5.7
-VALUES = {"stiction": 1.5, "dead_zone_duty": 25, "air_fraction": 0.01, "ccw_coulomb_scale": 1.1}
+VALUES = {"stiction": 1.5, "dead_zone_duty": 25, "air_fraction": 0.01, "ccw_coulomb_scale": 1.1,
+          "leak_conductance": 1e-14}
 
 
 def eq_4_5_7(y: float) -> float:
@@ -56,9 +57,10 @@ def chamber_volumes(y: float) -> tuple[float, float]:
 
 def make_circuit(*, substeps: int = ChamberParams().substeps, air_fraction: float = 0.0,
                  friction_params: FrictionParams = FRICTIONLESS, line: SupplyLineParams = CONSTANT_SUPPLY,
-                 supply: float = 300e3, initial_pressure: float = 0.0) -> CompressibleCircuit:
+                 supply: float = 300e3, initial_pressure: float = 0.0, leak: float = 0.0) -> CompressibleCircuit:
     return CompressibleCircuit(
-        chambers=ChamberParams(compressible=True, air_fraction=air_fraction, substeps=substeps),
+        chambers=ChamberParams(compressible=True, air_fraction=air_fraction, substeps=substeps,
+                               leak_conductance=leak),
         line=line, friction_params=friction_params, bore_area=AREA, stroke=STROKE,
         supply=np.array([supply]), initial_pressure=np.array([initial_pressure]))
 
@@ -341,7 +343,35 @@ def test_steady_velocity_with_direction_dependent_coulomb_compressible(force):
     assert circuit.state.pressure_a[0] == pytest.approx(-AREA * v[0] / G_OPEN, rel=1e-6)
 
 
-# --------------------------------------------------------------------------- 6. fine-step reference
+# --------------------------------------------------------------------------- 6. held supply valve creep
+
+
+LEAK = 1e-14  # m^3/(Pa s) from each chamber to the tank
+
+
+def creep_closed_form(direction: float) -> float:
+    """Supply valve of one pair open (g_1), everything else shut but leaking (g_l). Steady flow:
+    P_a = (g_1 P_s - A v) / (g_1 + g_l), P_b = A v / g_l, and (P_a - P_b) A = F_c + F_v v, so
+    v = (A g_1 P_s / (g_1 + g_l) - F_c) / (A^2 / (g_1 + g_l) + A^2 / g_l + F_v), mirrored for pair B."""
+    drive = AREA * G_OPEN * 300e3 / (G_OPEN + LEAK) - eq_4_5_7(Y_FIXED)
+    return direction * drive / (AREA**2 / (G_OPEN + LEAK) + AREA**2 / LEAK + THESIS_FRICTION.viscous)
+
+
+@pytest.mark.parametrize("direction", [1.0, -1.0])
+def test_held_supply_valve_creeps_the_rack_at_the_leak_rate(direction):
+    """The as-built plant's held_supply effect: no discharge valve open, yet the rack moves (1.5 deg/s here)."""
+    circuit = make_circuit(friction_params=THESIS_FRICTION, leak=LEAK, initial_pressure=150e3)
+    g = conductances(g1=G_OPEN) if direction > 0 else conductances(g3=G_OPEN)
+    v, stuck = np.zeros(1), np.ones(1, dtype=bool)
+    for _ in range(300):  # chamber time constant V / (beta g_l) = 19 ms
+        out = circuit.tick(conductance=g, y=np.array([Y_FIXED]), v0=v, external_force=np.zeros(1), stuck=stuck,
+                           mass=np.array([MASS]), h=H, breakaway=constant(0.0))
+        v, stuck = out.velocity, out.stuck
+    assert v[0] == pytest.approx(creep_closed_form(direction), rel=1e-6)
+    assert 1e-4 < abs(v[0]) < 2e-4
+
+
+# --------------------------------------------------------------------------- 7. fine-step reference
 
 
 def schedule(t: float) -> float:
@@ -387,7 +417,7 @@ def test_closed_loop_tracking_is_converged_in_the_substeps(controller):
     assert default == pytest.approx(fine, rel=0.02)
 
 
-# --------------------------------------------------------------------------- 7. switches
+# --------------------------------------------------------------------------- 8. switches
 
 
 def same(a: Result, b: Result) -> bool:
@@ -420,12 +450,23 @@ def test_all_effects_off_is_the_thesis_plant(controller, thesis_t4):
     assert same(ours, thesis)
 
 
-@pytest.mark.parametrize("effect", [e for e in EFFECTS if e != "supply_line"])
+@pytest.mark.parametrize("effect", [e for e in EFFECTS if e not in ("supply_line", "held_supply")])
 def test_each_effect_alone_changes_the_run(effect, thesis_t4):
     alone = as_built_plant(VALUES, without=[e for e in EFFECTS if e != effect])
     result = run(Scenario("ffpva", 4, plant=alone, seed=1))
     assert not result.warnings
     assert not same(result, thesis_t4("ffpva")), f"{effect} alone changes nothing"
+
+
+def test_the_held_supply_valve_changes_the_compressible_run_with_a_dead_zone():
+    """Below the dead zone the held supply valve pressurises one chamber; only a compressible,
+    leaking plant can move on it, so it is switched on on top of those."""
+    base = [e for e in EFFECTS if e not in ("compressibility", "dead_zone")]
+    shut = run(Scenario("smc", 1, plant=as_built_plant(VALUES, without=base), seed=1))
+    held = run(Scenario("smc", 1, plant=as_built_plant(VALUES, without=[e for e in base if e != "held_supply"]),
+                        seed=1))
+    assert not held.warnings
+    assert not same(held, shut)
 
 
 def test_the_supply_line_changes_the_compressible_run():

@@ -48,7 +48,7 @@ def test_a_failed_run_costs():
 def test_unit_box_maps_onto_the_plausible_bounds():
     assert values_at([0.0] * len(FITTED)) == {f.name: f.low for f in FITTED}
     assert values_at([1.0] * len(FITTED)) == {f.name: f.high for f in FITTED}
-    assert values_at([2.0, -1.0, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
+    assert values_at([2.0, -1.0, 0.5, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
 
 
 def test_committed_preset_is_inside_its_bounds_and_is_the_as_built_plant():
@@ -60,6 +60,8 @@ def test_committed_preset_is_inside_its_bounds_and_is_the_as_built_plant():
     assert plant.params.valves.dead_zone_duty == values["dead_zone_duty"]
     assert plant.params.chambers.air_fraction == values["air_fraction"]
     assert plant.params.friction.ccw_coulomb_scale == values["ccw_coulomb_scale"]
+    assert plant.params.chambers.leak_conductance == values["leak_conductance"]
+    assert plant.params.valves.supply_held_in_dead_zone
 
 
 def test_a_value_outside_its_bounds_is_refused(tmp_path):
@@ -81,7 +83,7 @@ def test_same_seeds_same_fit_whatever_the_workers():
 
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluations (the fixed starting simplex) cost
-    exactly what the committed file says. The whole fit (100 evaluations, ~6 min on 2 cores) is
+    exactly what the committed file says. The whole fit (100 evaluations, about 4 min on 2 cores) is
     ``twin calibrate --out DIR``; its file equals the committed one (see README, as-built)."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, max_evaluations=3)

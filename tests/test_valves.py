@@ -28,9 +28,10 @@ def r_of(duty_percent: float) -> float:
 FULL = 1.0 / r_of(100.0)  # conductance of a fully open valve, m^3/(Pa s)
 
 
-def drive(model: ValveModel, commands, *, dead_zone: float = 30.0) -> np.ndarray:
+def drive(model: ValveModel, commands, *, dead_zone: float = 30.0, hold_supply: bool = False) -> np.ndarray:
     """Conductances (ticks, 4) for one scenario given the command at each tick."""
-    bank = ValveBank(params=ValveParams(dead_zone_duty=dead_zone), model=model, n=1, tick=TICK)
+    bank = ValveBank(params=ValveParams(dead_zone_duty=dead_zone, supply_held_in_dead_zone=hold_supply),
+                     model=model, n=1, tick=TICK)
     return np.array([bank.update(k, np.array([float(u)]))[0] for k, u in enumerate(commands)])
 
 
@@ -65,6 +66,30 @@ def test_negative_command_uses_the_other_pair():
 def test_command_inside_the_30_percent_dead_zone_never_opens_anything(model, command):
     g = drive(model, [command] * 100, dead_zone=30.0)
     assert not (g > 0).any()
+
+
+@pytest.mark.parametrize("model", [ValveModel.PWM, ValveModel.AVERAGED])
+@pytest.mark.parametrize(("command", "supply", "others"), [(25.0, V1, [V2, V3, V4]), (-25.0, V3, [V1, V2, V4])])
+def test_held_supply_valve_opens_inside_the_dead_zone_and_the_drain_stays_shut(model, command, supply, others):
+    """§3: the pair's supply valve "stays fully on"; only the discharge valve's pulses are too short."""
+    g = drive(model, [command] * 40, dead_zone=30.0, hold_supply=True)
+    assert not (g[:5] > 0).any()  # the supply valve has its opening delay too
+    assert g[5:, supply] == pytest.approx(FULL, rel=1e-12)
+    assert not (g[:, others] > 0).any()
+
+
+def test_held_supply_shuts_at_zero_command_and_switches_pair_with_the_sign():
+    g = drive(ValveModel.AVERAGED, [20.0] * 10 + [0.0] * 10 + [-20.0] * 10, dead_zone=30.0, hold_supply=True)
+    is_open = g > 0
+    assert is_open[5:12, V1].all() and not is_open[12:, V1].any()  # coil off at tick 10, shut 2 ms later
+    assert not is_open[:25, V3].any() and is_open[25:, V3].all()
+    assert not is_open[:, [V2, V4]].any()
+
+
+def test_held_supply_changes_nothing_above_the_dead_zone():
+    commands = [50.0] * 40 + [-80.0] * 40 + [100.0] * 20
+    for model in ValveModel:
+        np.testing.assert_array_equal(drive(model, commands, hold_supply=True), drive(model, commands))
 
 
 def test_half_duty_pwm_opens_the_drain_valve_5_of_16_ticks():

@@ -37,7 +37,7 @@ CELLS = tuple((c, t) for c, row in THESIS_EXPERIMENT_RMSE_DEG.items() for t in r
 SSE_WEIGHT = 0.25
 FIT_SEEDS = (0, 1, 2)  # noise seeds of the ensemble the fit sees
 CHECK_SEEDS = (0, 1, 2, 3, 4)  # the thesis's five runs, for the residual table
-MAX_EVALUATIONS = 80
+MAX_EVALUATIONS = 100
 FILE_VERSION = 1
 
 

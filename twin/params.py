@@ -113,6 +113,10 @@ class ValveParams:
     opening_delay: float = 5e-3  # s
     closing_delay: float = 2e-3  # s
     dead_zone_duty: float = 30.0  # %, below it the real valve does not open
+    # §3: only the discharge valve is pulse-width-modulated, the pair's supply valve "stays fully on". True: it
+    # stays on while the discharge pulses are too short to open (|u| in the dead zone); False: the pair is shut
+    # together, the thesis's model, where an incompressible joint cannot tell the difference.
+    supply_held_in_dead_zone: bool = False
     resistance_coefficient: float = 1.8372e14  # Pa s/m^3 at d = 1 % (eq. 4.4.2, *resolution*: Pa s/m^3)
     resistance_exponent: float = -2.1706  # eq. 4.4.2
 
@@ -207,7 +211,7 @@ class ChamberParams:
     water_bulk_modulus: float = 2.19e9  # Pa, beta of water (§3)
     air_fraction: float = 0.0  # x_air: free air volume per chamber volume at atmospheric pressure (calibrated)
     dead_volume: float = 0.3e-6  # m^3 per chamber at the end of stroke: ports, hose to the valves (*assumed*)
-    leak_conductance: float = 0.0  # m^3/(Pa s) past each shut valve to the tank: pressure decays when closed
+    leak_conductance: float = 0.0  # m^3/(Pa s) past each discharge valve to the tank: a closed chamber relaxes
     initial_pressure_fraction: float = 0.5  # of the supply, in both chambers at the start (*assumed*: the
     # thesis pre-charges by moving the joint side to side; shut valves then trap a middle pressure)
     atmospheric_pressure: float = 101.325e3  # Pa

@@ -11,7 +11,9 @@ Two named valve models, both with the opening and closing delays of §3:
 ``averaged`` (the thesis's model)
     The discharge valve is a steady resistance R(|u|) of eq. 4.4.2 for the
     whole PWM period: the PWM is averaged out. Commands with |u| below
-    ``dead_zone_duty`` leave the valve shut.
+    ``dead_zone_duty`` leave the valve shut; the pair's supply valve shuts with
+    it, or stays on if ``supply_held_in_dead_zone`` (§3: the supply valve of
+    the pair "stays fully on"; only a compressible plant can tell the two apart).
 Both realise the duty in whole switching periods (``switching_period``, the
 DAQ's 1 ms output tick: 6.25 % steps of a 16 ms period); a duty under half a
 step sends no pulse. ``switching_period = 0`` makes the averaged valve
@@ -92,14 +94,14 @@ class ValveBank:
         out = np.empty((self.n, 4))
         duty = per_scenario(duty, self.n)  # read unchecked when compiled
         _valve_tick(duty, int(tick), self.duty_steps, self.period_ticks, self.model is ValveModel.AVERAGED,
-                    float(p.dead_zone_duty), float(p.resistance_coefficient), float(p.resistance_exponent),
+                    float(p.dead_zone_duty), bool(p.supply_held_in_dead_zone), float(p.resistance_coefficient), float(p.resistance_exponent),
                     float(self.full_conductance), self.open_ticks, self.close_ticks,
                     self._on_run, self._off_run, self._open, self._conductance, out)
         return out
 
 
 @numba.njit(cache=True)
-def _coil(magnitude, tick, duty_steps, period_ticks, averaged, dead_zone, coefficient, exponent,
+def _coil(magnitude, tick, duty_steps, period_ticks, averaged, dead_zone, hold_supply, coefficient, exponent,
           full):  # pragma: no cover - compiled
     """(supply, drain) coil conductance of the open pair with no delay, for |duty| ``magnitude`` <= 100 %."""
     if duty_steps:  # the coil switches on the DAQ's tick: a period of S ticks realises duties in 100/S % steps
@@ -107,7 +109,7 @@ def _coil(magnitude, tick, duty_steps, period_ticks, averaged, dead_zone, coeffi
     else:
         realised = magnitude
     if not (realised > 0 and magnitude >= dead_zone):
-        return 0.0, 0.0
+        return (full if hold_supply and magnitude > 0 else 0.0), 0.0
     if averaged:  # eq. 4.4.2 for the whole period
         return full, 1.0 / (coefficient * max(realised, 1e-9) ** exponent)
     in_pulse = (tick % period_ticks) < np.rint(realised / 100.0 * period_ticks)
@@ -115,12 +117,12 @@ def _coil(magnitude, tick, duty_steps, period_ticks, averaged, dead_zone, coeffi
 
 
 @numba.njit(cache=True)
-def _valve_tick(duty, tick, duty_steps, period_ticks, averaged, dead_zone, coefficient, exponent, full,
+def _valve_tick(duty, tick, duty_steps, period_ticks, averaged, dead_zone, hold_supply, coefficient, exponent, full,
                 open_ticks, close_ticks, on_run, off_run, is_open, conductance, out):  # pragma: no cover - compiled
     """One tick of every valve, in place on the delay state; ``out`` (n, 4) the conductances in force."""
     for i in range(duty.shape[0]):
         supply, drain = _coil(min(abs(duty[i]), 100.0), tick, duty_steps, period_ticks, averaged, dead_zone,
-                              coefficient, exponent, full)
+                              hold_supply, coefficient, exponent, full)
         coil = (supply if duty[i] > 0 else 0.0, drain if duty[i] < 0 else 0.0,
                 supply if duty[i] < 0 else 0.0, drain if duty[i] > 0 else 0.0)  # V1..V4
         for j in range(4):
