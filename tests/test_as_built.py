@@ -375,7 +375,7 @@ def test_held_supply_valve_creeps_the_rack_at_the_leak_rate(direction):
 
 
 def schedule(t: float) -> float:
-    """+60 % for 0.2 s, rest 0.2 s, -60 % for 0.2 s, then 0 (committed preset: 30 -> 156 -> 61 deg)."""
+    """+60 % for 0.2 s, rest 0.2 s, -60 % for 0.2 s, then 0 (committed preset: 35 -> 156 -> 49 deg)."""
     return 60.0 if t < 0.2 else 0.0 if t < 0.4 else -60.0 if t < 0.6 else 0.0
 
 
@@ -396,7 +396,7 @@ def test_default_substeps_match_a_fine_step_reference():
     rms_angle = math.degrees(np.sqrt(np.mean((coarse.angle - reference.angle) ** 2)))
     rms_pa = np.sqrt(np.mean((coarse.pressure_a - reference.pressure_a) ** 2))
     rms_pb = np.sqrt(np.mean((coarse.pressure_b - reference.pressure_b) ** 2))
-    # Measured (400 sub-steps, preset of 2026-11-23): 0.00085 deg, 0.014 and 0.013 kPa.
+    # Measured (400 sub-steps, second preset of 2026-11-23): 0.00062 deg, 0.0064 and 0.0062 kPa.
     assert rms_angle < 0.002
     assert rms_pa < 0.05e3 and rms_pb < 0.05e3
 
@@ -408,8 +408,8 @@ def test_closed_loop_tracking_is_converged_in_the_substeps(controller):
 
     Compared as an ensemble, as the thesis compares runs: a single closed-loop run is chaotic at its
     stick/slip and dead-zone events, so a 1e-6 deg difference early on can flip one of them seconds
-    later. Measured on the committed preset (2026-11-23): seed 0 of FF + PVA differs by 3.4 % (an
-    event that flips between 800 and 1600 sub-steps), the five-run mean by 1.6 %; sliding mode 0.1 %."""
+    later. Measured on the committed preset (second of 2026-11-23): single runs differ by up to 2.4 %
+    (FF + PVA) and 4.2 % (sliding mode), the five-run means by 0.4 % and 1.4 %."""
     plant = as_built_plant()
     default, fine = (np.mean([r.metrics.rmse for r in run_many([Scenario(controller, 3, plant=p, seed=seed)
                                                                  for seed in range(5)])])
