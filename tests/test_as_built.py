@@ -371,6 +371,32 @@ def test_held_supply_valve_creeps_the_rack_at_the_leak_rate(direction):
     assert 1e-4 < abs(v[0]) < 2e-4
 
 
+def creep_at(y: np.ndarray, direction: float) -> np.ndarray:
+    """``creep_closed_form`` with eq. 4.5.7 at rack positions ``y``."""
+    drive = AREA * G_OPEN * 300e3 / (G_OPEN + LEAK) - np.array([eq_4_5_7(x) for x in y])
+    return direction * drive / (AREA**2 / (G_OPEN + LEAK) + AREA**2 / LEAK + THESIS_FRICTION.viscous)
+
+
+@pytest.mark.parametrize("command", [10.0, -10.0])
+def test_a_command_inside_the_dead_zone_creeps_the_plant_at_the_closed_form_rate(command):
+    """Whole plant (valve bank, chambers, MuJoCo): |u| = 10 % is inside the 25 % dead zone, so no discharge
+    valve opens; with the held supply valve the joint creeps at the closed form, without it it stays put.
+    Air-free water, so the chambers settle in ~20 ms and the creep is quasi-steady along the stroke."""
+    keep = ("compressibility", "dead_zone", "held_supply")
+    values = dict(VALUES, air_fraction=0.0, leak_conductance=LEAK)
+    held = open_loop(command, plant=as_built_plant(values, without=[e for e in EFFECTS if e not in keep]),
+                     trajectory=3).trace
+    shut = open_loop(command, plant=as_built_plant(values, without=[e for e in EFFECTS if e not in keep[:2]]),
+                     trajectory=3).trace
+    late = held.time >= 1.0
+    velocity = np.gradient(held.rack_position, held.time)[late]
+    expected = creep_at(held.rack_position[late], math.copysign(1.0, command))
+    np.testing.assert_allclose(velocity, expected, rtol=0.01)  # measured: 0.1 %
+    assert abs(held.rack_position[-1] - held.rack_position[0]) > 0.3e-3  # > 3.6 deg in 3 s
+    assert np.ptp(shut.rack_position) < 1e-6
+    assert not held.valve_open[:, [1, 3]].any()  # the discharge valves V2, V4 never open
+
+
 # --------------------------------------------------------------------------- 7. fine-step reference
 
 

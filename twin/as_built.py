@@ -72,8 +72,8 @@ FITTED = (
     Fitted("ccw_coulomb_scale", 1.0, 1.5, "", "Coulomb friction towards 0 deg relative to eq. 4.5.7, which "
            "fits CW and CCW tests together: up to 50 % more one way"),
     Fitted("leak_conductance", 0.0, 3e-14, "m^3/(Pa s)", "past each discharge valve to the tank: from a tight "
-           "seat to 0.54 mL/min at 300 kPa (a 0.05 mL drop every 6 s: a visibly weeping seat; with the fitted "
-           "air, a closed chamber then keeps its pressure for a few tenths of a second)"),
+           "seat to 0.54 mL/min at 300 kPa (a 0.05 mL drop every 6 s: a visibly weeping seat, more than a "
+           "valve sold as normally closed would be let go with)"),
 )
 
 ASSUMED = {

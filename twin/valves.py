@@ -11,9 +11,7 @@ Two named valve models, both with the opening and closing delays of §3:
 ``averaged`` (the thesis's model)
     The discharge valve is a steady resistance R(|u|) of eq. 4.4.2 for the
     whole PWM period: the PWM is averaged out. Commands with |u| below
-    ``dead_zone_duty`` leave the valve shut; the pair's supply valve shuts with
-    it, or stays on if ``supply_held_in_dead_zone`` (§3: the supply valve of
-    the pair "stays fully on"; only a compressible plant can tell the two apart).
+    ``dead_zone_duty`` leave the valve shut.
 Both realise the duty in whole switching periods (``switching_period``, the
 DAQ's 1 ms output tick: 6.25 % steps of a 16 ms period); a duty under half a
 step sends no pulse. ``switching_period = 0`` makes the averaged valve
@@ -23,6 +21,11 @@ continuous (a sensitivity variant).
     Each valve is either shut or fully open (R(100 %)); the discharge valve's
     coil is on for the first |u| x period of each period. A pulse shorter than
     ``dead_zone_duty`` x period is not sent: the real valve does not open (§3).
+
+In both, while the discharge valve gets no pulse (|u| below the dead zone, or
+under half a switching step), the pair's supply valve shuts with it, or stays
+on if ``supply_held_in_dead_zone`` (§3: the supply valve of the pair "stays
+fully on"; only a compressible plant moves differently).
 
 Delays act on the coil signal: a shut valve opens once its coil has been on
 for ``opening_delay``, an open valve shuts once its coil has been off for
@@ -94,7 +97,8 @@ class ValveBank:
         out = np.empty((self.n, 4))
         duty = per_scenario(duty, self.n)  # read unchecked when compiled
         _valve_tick(duty, int(tick), self.duty_steps, self.period_ticks, self.model is ValveModel.AVERAGED,
-                    float(p.dead_zone_duty), bool(p.supply_held_in_dead_zone), float(p.resistance_coefficient), float(p.resistance_exponent),
+                    float(p.dead_zone_duty), bool(p.supply_held_in_dead_zone),
+                    float(p.resistance_coefficient), float(p.resistance_exponent),
                     float(self.full_conductance), self.open_ticks, self.close_ticks,
                     self._on_run, self._off_run, self._open, self._conductance, out)
         return out
