@@ -1,5 +1,5 @@
 """``twin study``: the robustness protocol's grid and tables (SPEC §9), the open-loop duty with soft limits
-and its lag measurement (SPEC §4.6), and the CLI."""
+and its lag measurement (SPEC §4.6), the as-built ablation, and the CLI."""
 
 from __future__ import annotations
 
@@ -16,7 +16,9 @@ import numpy as np
 import pytest
 
 from controllers.open_loop import ReversingSine
-from twin import studies
+from twin import ablation, studies
+from twin.as_built import EFFECTS, calibrated_values
+from twin.calibrate import CELLS, Evaluator
 from twin.control import Measurement, Setpoint
 from twin.plants import PLANTS
 from twin.studies import Reversal, paired_reversals, reversal_lags
@@ -261,7 +263,33 @@ def test_cli_openloop_writes_the_csv_and_the_figure(tmp_path):
     assert "lag ms" in proc.stdout and f"{chosen}: mean lag" in proc.stdout
 
 
+# --- ablation ---------------------------------------------------------------------------------------------------
+
+def test_ablation_switches_each_effect_off_once_and_the_line_with_the_chambers():
+    found = dict(ablation.variants())
+    assert found.pop("as-built") == ()
+    assert found == {f"- {e}": ((e, "supply_line") if e == "compressibility" else (e,)) for e in EFFECTS}
+
+
+def test_cli_ablation_writes_every_variant_and_cell(tmp_path):
+    proc = twin(tmp_path, "study", "ablation", "--seeds", "1", "--workers", "2", "--out", "ab")
+    assert proc.returncode == 0, proc.stderr
+    _, rows = _rows(tmp_path / "ab" / "ablation.csv")
+    assert len(rows) == len(ablation.variants()) * len(CELLS)
+    assert (tmp_path / "ab" / "ablation.png").read_bytes().startswith(PNG_MAGIC)
+    table = {(r["variant"], r["controller"], int(r["trajectory"])): float(r["twin_rmse_deg"]) for r in rows}
+    evaluator = Evaluator(seeds=(0,), workers=1)
+    preset = evaluator.cells(calibrated_values())
+    evaluator.close()
+    for cell in preset:  # the first row is the committed preset, as calibrate scores it
+        assert table["as-built", cell.controller, cell.trajectory] == round(cell.mean_rmse, 4)
+    # Without the dead zone every controller tracks far better than the as-built joint (README: 1.4-4.3x).
+    assert all(table["- dead_zone", c, t] < table["as-built", c, t] for c, t in CELLS)
+    assert "within" in proc.stdout and f"/{len(CELLS)}" in proc.stdout
+
+
 @pytest.mark.parametrize("args, bad", [
+    (["study", "ablation", "--seeds", "0", "--out", "x"], "'0'"),
     (["study", "openloop", "--plant", "nope", "--out", "x"], "nope"),
     (["study", "robustness", "--plant", "nope", "--out", "x"], "nope"),
     (["study", "robustness", "--seeds", "0", "--out", "x"], "'0'"),

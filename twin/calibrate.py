@@ -63,10 +63,10 @@ def values_at(u: Sequence[float]) -> dict[str, float]:
     return {f.name: f.low + float(np.clip(x, 0.0, 1.0)) * (f.high - f.low) for f, x in zip(FITTED, u, strict=True)}
 
 
-def _run_cells(values: dict[str, float], jobs: list[tuple[str, int, int]]) -> list[tuple]:
+def _run_cells(values: dict[str, float], jobs: list[tuple[str, int, int]], without: tuple[str, ...] = ()) -> list[tuple]:
     from twin.runner import run_many
 
-    plant = as_built_plant(values, name="as-built-fit")
+    plant = as_built_plant(values, name="as-built-fit", without=without)
     results = run_many([Scenario(c, t, plant=plant, seed=s) for c, t, s in jobs], nthread=1)
     return [(r.scenario.controller, r.scenario.trajectory, r.scenario.seed, math.degrees(r.metrics.rmse),
              math.degrees(r.metrics.sse), bool(r.warnings)) for r in results]
@@ -84,14 +84,17 @@ class Evaluator:
         if self.pool is not None:
             self.pool.shutdown()
 
-    def cells(self, values: dict[str, float]) -> list[CellResult]:
+    def cells(self, values: dict[str, float], *, without: Sequence[str] = ()) -> list[CellResult]:
+        """The experimental cells with the as-built plant at ``values``, minus the effects in ``without``."""
         jobs = [(c, t, s) for c, t in CELLS for s in self.seeds]
         # Interleave by trajectory so every worker gets a like mix of long and short runs.
         shares = [share for share in (jobs[i::self.workers] for i in range(self.workers)) if share]
+        off = tuple(without)
         if self.pool is None:
-            rows = _run_cells(values, jobs)
+            rows = _run_cells(values, jobs, off)
         else:
-            rows = [row for part in self.pool.map(_run_cells, [values] * len(shares), shares) for row in part]
+            rows = [row for part in self.pool.map(_run_cells, [values] * len(shares), shares, [off] * len(shares))
+                    for row in part]
         found: dict[tuple[str, int], list] = {}
         for controller, trajectory, _seed, rmse, sse, failed in sorted(rows, key=lambda row: row[:3]):
             found.setdefault((controller, trajectory), []).append((rmse, sse, failed))

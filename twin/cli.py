@@ -5,6 +5,7 @@
     twin bench                     cost per simulated second
     twin view --controller smc --trajectory 4              the joint live in a browser
     twin study robustness --out DIR                        the thesis's Chapter 6 protocol
+    twin study ablation --out DIR                          each as-built effect off in turn, against SPEC §8
 
 Degrees, grams and kPa here; SI inside. Bad input gets a one-line error and
 exit code 2, and nothing is written.
@@ -321,6 +322,27 @@ def _cmd_whatif(args: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_ablation(args: argparse.Namespace) -> int:
+    from twin import ablation, tables
+    from twin.as_built import calibrated_values
+    from viz.study_plots import plot_ablation
+
+    calibrated_values()  # no committed preset: a one-line error before anything is written
+    args.out.mkdir(exist_ok=True)
+    count = len(ablation.variants())
+    print(f"{count} variants x 11 cells x {args.seeds} seeds on the as-built plant -> {args.out.resolve()}",
+          file=sys.stderr)
+    done = iter(range(1, count + 1))
+    study = ablation.ablation_study(seeds=range(args.seeds), workers=args.workers,
+                                    progress=lambda label: print(f"[{next(done)}/{count}] {label}", file=sys.stderr))
+    csv, png = args.out / "ablation.csv", args.out / "ablation.png"
+    tables.write_csv(study.rows, list(study.rows[0]), csv)
+    plot_ablation(study.rows, png)
+    print(ablation.format_ablation(study))
+    print(f"wrote {csv}, {png}")
+    return 1 if any(r["failed_runs"] for r in study.rows) else 0
+
+
 def _cmd_study(args: argparse.Namespace) -> int:
     from twin import studies
     from twin.plants import plant
@@ -412,6 +434,12 @@ def build_parser() -> argparse.ArgumentParser:
                              help="default: as-built if present, else thesis (robustness) or thesis-pwm (openloop)")
         parser_.add_argument("--out", type=_out_dir, required=True, metavar="DIR", help="output folder (created)")
         parser_.set_defaults(func=_cmd_study)
+    ablation = studies.add_parser("ablation", help="the as-built preset on SPEC §8's cells with each effect "
+                                  "switched off in turn")
+    ablation.add_argument("--seeds", type=_positive_int, default=5, help="noise seeds per cell (default 5)")
+    ablation.add_argument("--workers", type=_positive_int, default=2, help="processes (default 2)")
+    ablation.add_argument("--out", type=_out_dir, required=True, metavar="DIR", help="output folder (created)")
+    ablation.set_defaults(func=_cmd_ablation)
 
     run = sub.add_parser("run", help="simulate one scenario")
     add_scenario_arguments(run)
