@@ -13,8 +13,8 @@ import dataclasses
 from collections.abc import Callable, Sequence
 
 from twin.as_built import EFFECTS, calibrated_values
-from twin.calibrate import CHECK_SEEDS, Evaluator
-from twin.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG
+from twin.calibrate import CHECK_SEEDS, Evaluator, cell_rows
+from twin.reference import THESIS_EXPERIMENT_RMSE_DEG
 
 TOLERANCE = 0.2  # the bar: the twin's mean RMSE within 20 % of the experiment's
 
@@ -42,16 +42,10 @@ def ablation_study(*, seeds: Sequence[int] = CHECK_SEEDS, workers: int = 2,
     rows = []
     try:
         for label, off in variants():
-            for cell in evaluator.cells(values, without=off):
-                experiment = THESIS_EXPERIMENT_RMSE_DEG[cell.controller][cell.trajectory][0]
-                ratio = cell.mean_rmse / experiment
-                rows.append({"variant": label, "controller": cell.controller, "trajectory": cell.trajectory,
-                             "twin_rmse_deg": round(cell.mean_rmse, 4), "experiment_rmse_deg": experiment,
-                             "ratio": round(ratio, 4), "within_tolerance": abs(ratio - 1.0) <= TOLERANCE,
-                             "twin_sse_range_deg": round(cell.sse_range, 4) if cell.trajectory == 1 else None,
-                             "experiment_sse_range_deg": (THESIS_EXPERIMENT_SSE_T1_RANGE_DEG[cell.controller]
-                                                          if cell.trajectory == 1 else None),
-                             "failed_runs": cell.failed})
+            cells = evaluator.cells(values, without=off)
+            for cell, row in zip(cells, cell_rows(cells), strict=True):
+                within = abs(cell.mean_rmse / row["experiment_rmse_deg"] - 1.0) <= TOLERANCE
+                rows.append({"variant": label, **row, "within_tolerance": within})
             if progress is not None:
                 progress(label)
     finally:

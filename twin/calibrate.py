@@ -166,7 +166,8 @@ def calibrate(*, workers: int = 2, max_evaluations: int = MAX_EVALUATIONS, fit_s
                        wall_time=time.perf_counter() - started)
 
 
-def _cell_rows(cells: Sequence[CellResult]) -> list[dict]:
+def cell_rows(cells: Sequence[CellResult]) -> list[dict]:
+    """One row per cell: the experiment's RMSE and std, the twin's, their ratio, the T1 SSE ranges."""
     rows = []
     for cell in cells:
         target, spread = THESIS_EXPERIMENT_RMSE_DEG[cell.controller][cell.trajectory]
@@ -195,8 +196,8 @@ def record(result: Calibration, *, max_evaluations: int, fit_seeds: Sequence[int
         "cost": result.cost,
         "evaluations": result.evaluations,
         "wall_time_s": round(result.wall_time, 1),
-        "residuals_fit_seeds": _cell_rows(result.fit_cells),
-        "residuals_check_seeds": _cell_rows(result.check_cells),
+        "residuals_fit_seeds": cell_rows(result.fit_cells),
+        "residuals_check_seeds": cell_rows(result.check_cells),
         "check_seeds": list(check_seeds),
         "history": [{"values": dict(values), "cost": c}
                     for values, c in result.history],
