@@ -36,18 +36,19 @@ class Ablation:
 
 
 def ablation_study(*, seeds: Sequence[int] = CHECK_SEEDS, workers: int = 2,
-                   progress: Callable[[str], None] | None = None) -> Ablation:
+                   progress: Callable[[int, int, str], None] | None = None) -> Ablation:
+    """``progress(done, total, variant)`` after each variant."""
     values = calibrated_values()
     evaluator = Evaluator(seeds=seeds, workers=workers)
     rows = []
     try:
-        for label, off in variants():
+        for done, (label, off) in enumerate(variants(), start=1):
             cells = evaluator.cells(values, without=off)
             for cell, row in zip(cells, cell_rows(cells), strict=True):
                 within = abs(cell.mean_rmse / row["experiment_rmse_deg"] - 1.0) <= TOLERANCE
                 rows.append({"variant": label, **row, "within_tolerance": within})
             if progress is not None:
-                progress(label)
+                progress(done, len(variants()), label)
     finally:
         evaluator.close()
     return Ablation(rows=rows, seeds=tuple(seeds))

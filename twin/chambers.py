@@ -101,13 +101,13 @@ class CompressibleCircuit:
         position (the rack moves at most 0.15 mm in a tick: 0.5 % of a chamber)."""
         s, ch, fp = self.state, self.chambers, self.friction
         va, vb = self.volumes(y)
-        forward = friction.coulomb_force(fp, y, np.ones_like(y))  # towards +y; towards 0 deg it is scaled
+        forward, backward = friction.coulomb_both_ways(fp, y)
         line = self._line if self._line is not None else (1.0, 1.0, 0.0)
         out = np.empty((4, len(y)))
         _substeps(
             s.pressure_a, s.pressure_b, s.supply_pressure, s.line_flow, np.ascontiguousarray(conductance, dtype=float),
             va, vb, np.asarray(y, dtype=float), self.stroke[0], self.stroke[1],
-            forward, forward * fp.ccw_coulomb_scale,
+            forward, backward,
             np.asarray(breakaway(y), dtype=float), np.asarray(v0, dtype=float), np.asarray(stuck, dtype=np.bool_),
             np.asarray(mass, dtype=float), np.asarray(external_force, dtype=float), self.source,
             self.area, fp.viscous, h / ch.substeps, ch.substeps, ch.leak_conductance,

@@ -329,12 +329,11 @@ def _cmd_ablation(args: argparse.Namespace) -> int:
 
     calibrated_values()  # no committed preset: a one-line error before anything is written
     args.out.mkdir(exist_ok=True)
-    count = len(ablation.variants())
-    print(f"{count} variants x 11 cells x {args.seeds} seeds on the as-built plant -> {args.out.resolve()}",
-          file=sys.stderr)
-    done = iter(range(1, count + 1))
+    print(f"{len(ablation.variants())} variants x 11 cells x {args.seeds} seeds on the as-built plant -> "
+          f"{args.out.resolve()}", file=sys.stderr)
     study = ablation.ablation_study(seeds=range(args.seeds), workers=args.workers,
-                                    progress=lambda label: print(f"[{next(done)}/{count}] {label}", file=sys.stderr))
+                                    progress=lambda done, total, label: print(f"[{done}/{total}] {label}",
+                                                                              file=sys.stderr))
     csv, png = args.out / "ablation.csv", args.out / "ablation.png"
     tables.write_csv(study.rows, list(study.rows[0]), csv)
     plot_ablation(study.rows, png)

@@ -48,6 +48,13 @@ def coulomb_force(params: FrictionParams, y: np.ndarray, direction: np.ndarray) 
     return out
 
 
+def coulomb_both_ways(params: FrictionParams, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """F_c(y) moving towards +y and towards 0 deg, for the steps that decide the direction inside their
+    compiled loops; each the same numbers as :func:`coulomb_force` in that direction."""
+    forward = coulomb_force(params, y, np.ones(np.shape(y)))
+    return forward, forward * params.ccw_coulomb_scale
+
+
 def force_loss(params: FrictionParams, y: np.ndarray, v: np.ndarray) -> np.ndarray:
     """F_l(y, v) = F_c(y) sgn(v) + F_v v in N (eq. 4.5.5), the model the controllers invert."""
     direction = np.sign(v)

@@ -185,8 +185,7 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
         return per_scenario(x, n, dtype)
 
     static = friction_params.stiction if breakaway is None else breakaway
-    forward = each(friction.coulomb_force(friction_params, y, np.ones(n)))  # eq. 4.5.7, towards +y
-    backward = forward * friction_params.ccw_coulomb_scale  # towards 0 deg, as coulomb_force scales it
+    forward, backward = (each(f) for f in friction.coulomb_both_ways(friction_params, y))  # eq. 4.5.7
     out, stuck_out = np.empty((6, n)), np.empty(n, dtype=np.bool_)
     _rack_steps(circuit_now.conductances, circuit_now.supply_pressure, float(bore_area),
                 float(friction_params.viscous), forward, backward, each(v0), each(external_force),
