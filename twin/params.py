@@ -115,8 +115,8 @@ class ValveParams:
     dead_zone_duty: float = 30.0  # %, below it the real valve does not open
     # §3: only the discharge valve is pulse-width-modulated, the pair's supply valve "stays fully on". True: it
     # stays on while the discharge valve gets no pulse that opens it (|u| in the dead zone, or below half a 1 ms
-    # step); False: the pair is shut together, the thesis's model. An incompressible joint moves the same either
-    # way (only its locked chambers' pressures and the tooth forces they cause differ).
+    # step); False: the pair is shut together, the thesis's model. An incompressible joint hardly moves
+    # differently (no flow either way; the held valve only squeezes the locked train: <= 4e-4 deg).
     supply_held_in_dead_zone: bool = False
     resistance_coefficient: float = 1.8372e14  # Pa s/m^3 at d = 1 % (eq. 4.4.2, *resolution*: Pa s/m^3)
     resistance_exponent: float = -2.1706  # eq. 4.4.2
