@@ -25,10 +25,26 @@ def exact_cells(scale: dict | None = None) -> list[CellResult]:
     return cells
 
 
-def test_cost_is_zero_on_the_table_and_log_ratio_squared_off_it():
+def cauchy(r: float) -> float:
+    c = math.log(1.2)
+    return c * c * math.log(1.0 + (r / c) ** 2)
+
+
+def test_cost_is_zero_on_the_table_and_cauchy_of_the_log_ratio_off_it():
     assert cost(exact_cells()) == pytest.approx(0.0, abs=1e-12)
-    assert cost(exact_cells({("smc", 3): 2.0})) == pytest.approx(math.log(2.0) ** 2)
-    assert cost(exact_cells({("pva", 2): 0.5})) == pytest.approx(math.log(2.0) ** 2)
+    assert cost(exact_cells({("smc", 3): 2.0})) == pytest.approx(cauchy(math.log(2.0)))
+    assert cost(exact_cells({("pva", 2): 0.5})) == pytest.approx(cauchy(math.log(2.0)))
+
+
+def test_cost_is_the_squared_log_ratio_near_the_table_and_grows_slowly_far_out():
+    near = cost(exact_cells({("ffpva", 3): 1.01}))
+    assert near == pytest.approx(math.log(1.01) ** 2, rel=5e-3)
+    far = cost(exact_cells({("pva", 1): 0.25}))
+    at_the_bar = cost(exact_cells({("smc", 2): 1.2}))
+    assert far > 2 * at_the_bar  # a factor-4 miss still costs more than two cells at the 20 % bar ...
+    pull_far = cost(exact_cells({("pva", 1): 0.25 / 1.05})) - far
+    pull_at_the_bar = cost(exact_cells({("smc", 2): 1.2 * 1.05})) - at_the_bar
+    assert 0 < pull_far < pull_at_the_bar / 3  # ... but a further 5 % there pulls far less than at the bar
 
 
 def test_cost_weighs_the_t1_steady_error_range():
@@ -36,7 +52,7 @@ def test_cost_weighs_the_t1_steady_error_range():
     ffpva_t1 = next(i for i, c in enumerate(cells) if (c.controller, c.trajectory) == ("ffpva", 1))
     doubled = 2 * THESIS_EXPERIMENT_SSE_T1_RANGE_DEG["ffpva"]
     cells[ffpva_t1] = CellResult("ffpva", 1, cells[ffpva_t1].rmse_deg, (0.1, -doubled), 0)
-    assert cost(cells) == pytest.approx(calibrate.SSE_WEIGHT * math.log(2.0) ** 2)
+    assert cost(cells) == pytest.approx(cauchy(math.sqrt(calibrate.SSE_WEIGHT) * math.log(2.0)))
 
 
 def test_a_failed_run_costs():
