@@ -70,7 +70,7 @@ def test_reduced_robustness_run_writes_three_files_and_marks_a_failed_run(tmp_pa
     monkeypatch.setattr(twin.runner, "run_many", with_a_warning)
     study = studies.robustness_study(out=tmp_path, plant_name="thesis", seeds=1, trajectories=(1,), workers=1)
     studies.write_robustness(study, tmp_path)
-    plot_robustness(study.summary, tmp_path / "robustness.png")
+    plot_robustness(study.runs, tmp_path / "robustness.png")
 
     columns, runs = _rows(tmp_path / "robustness_runs.csv")
     assert columns == ["plant", "controller", "trajectory", "payload_g", "orientation", "seed", "status",

@@ -365,7 +365,7 @@ def _cmd_study(args: argparse.Namespace) -> int:
                   "run the same command again to finish the rest", file=sys.stderr)
             return 130
         paths = studies.write_robustness(study, args.out) + [args.out / "robustness.png"]
-        plot_robustness(study.summary, paths[-1])
+        plot_robustness(study.runs, paths[-1])
         print(studies.format_robustness(study))
         failed = bool(study.failed)
     else:

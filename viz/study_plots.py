@@ -11,6 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import FuncFormatter  # noqa: E402
 
 from twin.demo import LABELS  # noqa: E402
 from twin.plants import plant  # noqa: E402
@@ -19,30 +20,39 @@ from twin.studies import SOFT_LIMITS, OpenLoopStudy  # noqa: E402
 ORIENTATION_STYLES = {"horizontal": "-", "vertical": "--"}
 
 
-def plot_robustness(summary: Sequence[dict], path: pathlib.Path) -> None:
-    """RMSE (mean, std error bars) against tip payload; one panel per trajectory, a line per
-    controller x orientation (colour: controller, line style: orientation)."""
-    trajectories = sorted({s["trajectory"] for s in summary})
+def plot_robustness(runs: Sequence[dict], path: pathlib.Path) -> None:
+    """RMSE against tip payload: every finished run a dot, the median of each cell a line; one panel per
+    trajectory, colour per controller, line style per orientation. Log scale, so that a stalled run
+    (tens of degrees) shows as the outlier it is instead of flattening the others."""
+    finished = [r for r in runs if r["status"] != "failed" and r["rmse_deg"] is not None]
+    trajectories = sorted({r["trajectory"] for r in runs})
     fig, axes = plt.subplots(1, len(trajectories), figsize=(5.5 * len(trajectories), 4.5), squeeze=False,
                              sharey=True, constrained_layout=True)
-    controllers = sorted({s["controller"] for s in summary})
+    controllers = sorted({r["controller"] for r in runs})
+    lines = [(c, o) for c in controllers for o in ORIENTATION_STYLES]
     for ax, trajectory in zip(axes[0], trajectories, strict=True):
-        for c_index, controller in enumerate(controllers):
-            for orientation, style in ORIENTATION_STYLES.items():
-                members = sorted((s for s in summary if (s["trajectory"], s["controller"], s["orientation"])
-                                  == (trajectory, controller, orientation)), key=lambda s: s["payload_g"])
-                if not members:
-                    continue
-                mean = [np.nan if s["rmse_mean_deg"] is None else s["rmse_mean_deg"] for s in members]
-                std = [np.nan if s["rmse_std_deg"] is None else s["rmse_std_deg"] for s in members]
-                x = [s["payload_g"] for s in members]
-                ax.plot(x, mean, ls=style, marker="o", color=f"C{c_index}", label=f"{LABELS[controller]}, {orientation}")
-                ax.errorbar(x, mean, yerr=std, fmt="none", ecolor=f"C{c_index}", capsize=3)
-        ax.set_title(f"T{trajectory} ({summary[0]['plant']} plant)")
+        for line_index, (controller, orientation) in enumerate(lines):
+            members = [r for r in finished if (r["trajectory"], r["controller"], r["orientation"])
+                       == (trajectory, controller, orientation)]
+            if not members:
+                continue
+            color = f"C{controllers.index(controller)}"
+            payloads = sorted({r["payload_g"] for r in members})
+            offset = 0.15 * (line_index - (len(lines) - 1) / 2)  # side by side, so the dots do not hide
+            median = [float(np.median([r["rmse_deg"] for r in members if r["payload_g"] == g])) for g in payloads]
+            ax.plot([g + offset for g in payloads], median, ls=ORIENTATION_STYLES[orientation], color=color,
+                    label=f"{LABELS[controller]}, {orientation}")
+            ax.plot([r["payload_g"] + offset for r in members], [r["rmse_deg"] for r in members], ls="none",
+                    marker="o", ms=3.5, alpha=0.6, color=color)
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
+        ax.yaxis.set_minor_formatter(FuncFormatter(lambda value, _: f"{value:g}" if round(value) in (2, 3, 5, 20, 50)
+                                                   and abs(value - round(value)) < 1e-9 else ""))
+        ax.set_title(f"T{trajectory} ({runs[0]['plant']} plant)")
         ax.set_xlabel("payload at the link tip (g)")
-        ax.grid(alpha=0.3)
+        ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8, handlelength=3.5)  # long enough to show the dashes
-    axes[0][0].set_ylabel("RMSE (deg), mean ± std over seeds")
+    axes[0][0].set_ylabel("RMSE (deg): runs (dots), median (line)")
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
