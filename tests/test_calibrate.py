@@ -47,6 +47,17 @@ def test_cost_is_the_squared_log_ratio_near_the_table_and_grows_slowly_far_out()
     assert 0 < pull_far < pull_at_the_bar / 3  # ... but a further 5 % there pulls far less than at the bar
 
 
+def test_cost_is_a_sum_over_cells_so_a_far_miss_does_not_change_the_pull_on_another_cell():
+    far, at_the_bar = {("pva", 1): 0.25}, {("smc", 2): 1.2}
+    both = cost(exact_cells(far | at_the_bar))
+    assert both == pytest.approx(cost(exact_cells(far)) + cost(exact_cells(at_the_bar)))
+    nudged = {("smc", 2): 1.26}
+    pull_alone = cost(exact_cells(nudged)) - cost(exact_cells(at_the_bar))
+    pull_with_far_miss = cost(exact_cells(far | nudged)) - both
+    assert pull_with_far_miss == pytest.approx(pull_alone)
+    assert pull_alone == pytest.approx(cauchy(math.log(1.26)) - cauchy(math.log(1.2)))
+
+
 def test_cost_weighs_the_t1_steady_error_range():
     cells = exact_cells()
     ffpva_t1 = next(i for i, c in enumerate(cells) if (c.controller, c.trajectory) == ("ffpva", 1))

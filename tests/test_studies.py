@@ -97,6 +97,13 @@ def test_reduced_robustness_run_writes_three_files_and_marks_a_failed_run(tmp_pa
             assert s["rmse_std_deg"] == ""  # one seed: no spread
     assert (tmp_path / "robustness.png").read_bytes().startswith(PNG_MAGIC)
 
+    from viz.study_plots import robustness_figure
+    figure = robustness_figure(study.runs)
+    (axis,) = figure.axes
+    dots = [y for line in axis.lines if line.get_marker() == "o" for y in line.get_ydata()]
+    assert sorted(dots) == sorted(r["rmse_deg"] for r in study.runs if r["status"] == "ok")  # the failed one is not drawn
+    assert "1 failed" in axis.get_title()
+
     table = studies.format_robustness(study)
     assert "T1: steady-state error per run" in table and "T1: RMSE per run, mean and std" in table
     assert "12 runs, 1 failed" in table and "mjWARN_BADQACC" in table

@@ -11,7 +11,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.ticker import FuncFormatter  # noqa: E402
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
 from twin.demo import LABELS  # noqa: E402
 from twin.plants import plant  # noqa: E402
@@ -20,10 +20,13 @@ from twin.studies import SOFT_LIMITS, OpenLoopStudy  # noqa: E402
 ORIENTATION_STYLES = {"horizontal": "-", "vertical": "--"}
 
 
-def plot_robustness(runs: Sequence[dict], path: pathlib.Path) -> None:
+def robustness_figure(runs: Sequence[dict]) -> plt.Figure:
     """RMSE against tip payload: every finished run a dot, the median of each cell a line; one panel per
-    trajectory, colour per controller, line style per orientation. Log scale, so that a stalled run
-    (tens of degrees) shows as the outlier it is instead of flattening the others."""
+    trajectory (its title counts the failed runs, which are not drawn), colour per controller, line style
+    per orientation. Log scale, so that a stalled run (tens of degrees) shows as the outlier it is
+    instead of flattening the others."""
+    if not runs:
+        raise ValueError("no robustness runs to plot")
     finished = [r for r in runs if r["status"] != "failed" and r["rmse_deg"] is not None]
     trajectories = sorted({r["trajectory"] for r in runs})
     fig, axes = plt.subplots(1, len(trajectories), figsize=(5.5 * len(trajectories), 4.5), squeeze=False,
@@ -45,14 +48,23 @@ def plot_robustness(runs: Sequence[dict], path: pathlib.Path) -> None:
             ax.plot([r["payload_g"] + offset for r in members], [r["rmse_deg"] for r in members], ls="none",
                     marker="o", ms=3.5, alpha=0.6, color=color)
         ax.set_yscale("log")
+        ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
         ax.yaxis.set_major_formatter(FuncFormatter(lambda value, _: f"{value:g}"))
-        ax.yaxis.set_minor_formatter(FuncFormatter(lambda value, _: f"{value:g}" if round(value) in (2, 3, 5, 20, 50)
-                                                   and abs(value - round(value)) < 1e-9 else ""))
-        ax.set_title(f"T{trajectory} ({runs[0]['plant']} plant)")
+        ax.yaxis.set_minor_formatter(NullFormatter())
+        failed = sum(r["trajectory"] == trajectory for r in runs) - sum(r["trajectory"] == trajectory
+                                                                         for r in finished)
+        ax.set_title(f"T{trajectory} ({runs[0]['plant']} plant)" + (f", {failed} failed runs not shown" if failed else ""))
         ax.set_xlabel("payload at the link tip (g)")
         ax.grid(alpha=0.3, which="both")
-        ax.legend(fontsize=8, handlelength=3.5)  # long enough to show the dashes
+        if ax.get_legend_handles_labels()[0]:
+            ax.legend(fontsize=8, handlelength=3.5)  # long enough to show the dashes
     axes[0][0].set_ylabel("RMSE (deg): runs (dots), median (line)")
+    return fig
+
+
+def plot_robustness(runs: Sequence[dict], path: pathlib.Path) -> None:
+    """:func:`robustness_figure`, written to ``path``."""
+    fig = robustness_figure(runs)
     fig.savefig(path, dpi=90)
     plt.close(fig)
 
