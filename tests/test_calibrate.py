@@ -72,6 +72,25 @@ def test_a_failed_run_costs():
     assert cost(cells) == pytest.approx(1.0)
 
 
+def test_record_keeps_the_ensemble_and_the_table_and_plot_show_it(tmp_path):
+    from viz.calibration_plots import plot_calibration
+
+    result = calibrate.Calibration(values=calibrated_values(), cost=0.0, evaluations=1,
+                                   history=[(calibrated_values(), 0.5)], fit_cells=exact_cells(),
+                                   check_cells=exact_cells(), ensemble_cells=exact_cells({("smc", 4): 0.75}),
+                                   wall_time=1.0)
+    data = calibrate.record(result, max_evaluations=1, fit_seeds=(0,), check_seeds=(0,), ensemble_seeds=range(20))
+    assert data["ensemble_seeds"] == list(range(20))
+    (smc_t4,) = [r for r in data["residuals_ensemble_seeds"] if (r["controller"], r["trajectory"]) == ("smc", 4)]
+    assert smc_t4["ratio"] == pytest.approx(0.75)
+    table = calibrate.format_residuals(data)
+    assert "20 seeds: twin/exp" in table.splitlines()[0]
+    assert table.splitlines()[len(calibrate.CELLS)].split()[-1] == "0.75"  # the last cell is sliding mode T4
+    plot_calibration(data["residuals_check_seeds"], data["history"], tmp_path / "c.png",
+                     data["residuals_ensemble_seeds"], 20)
+    assert (tmp_path / "c.png").stat().st_size > 0
+
+
 def test_unit_box_maps_onto_the_plausible_bounds():
     assert values_at([0.0] * len(FITTED)) == {f.name: f.low for f in FITTED}
     assert values_at([1.0] * len(FITTED)) == {f.name: f.high for f in FITTED}
@@ -101,11 +120,13 @@ def test_a_value_outside_its_bounds_is_refused(tmp_path):
 
 
 def test_same_seeds_same_fit_whatever_the_workers():
-    small = dict(max_evaluations=2, fit_seeds=(0, 1, 2), check_seeds=(0,))
+    small = dict(max_evaluations=2, fit_seeds=(0, 1, 2), check_seeds=(0,), ensemble_seeds=(1,))
     one = calibrate.calibrate(workers=1, **small)
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost
     assert [c.rmse_deg for c in one.check_cells] == [c.rmse_deg for c in two.check_cells]
+    assert [c.rmse_deg for c in one.ensemble_cells] == [c.rmse_deg for c in two.ensemble_cells]
+    assert len(one.ensemble_cells) == len(calibrate.CELLS)
 
 
 def test_calibrate_retraces_the_committed_fit():
@@ -113,7 +134,7 @@ def test_calibrate_retraces_the_committed_fit():
     exactly what the committed file says. The whole fit (100 evaluations, about 4 min on 2 cores) is
     ``twin calibrate --out DIR``; its file equals the committed one (see README, as-built)."""
     committed = json.loads(CALIBRATION_FILE.read_text())
-    result = calibrate.calibrate(workers=2, max_evaluations=3)
+    result = calibrate.calibrate(workers=2, max_evaluations=3, check_seeds=(), ensemble_seeds=())
     for (values, cost_now), expected in zip(result.history, committed["history"][:3], strict=True):
         assert values == expected["values"]
         assert cost_now == expected["cost"]

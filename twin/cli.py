@@ -188,9 +188,10 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         args.max_evaluations = calibrate.MAX_EVALUATIONS
     result = calibrate.calibrate(workers=args.workers, max_evaluations=args.max_evaluations, progress=progress)
     data = calibrate.record(result, max_evaluations=args.max_evaluations, fit_seeds=calibrate.FIT_SEEDS,
-                            check_seeds=calibrate.CHECK_SEEDS)
+                            check_seeds=calibrate.CHECK_SEEDS, ensemble_seeds=calibrate.ENSEMBLE_SEEDS)
     path = calibrate.write(data, args.out)
-    plot_calibration(data["residuals_check_seeds"], data["history"], args.out / "calibration.png")
+    plot_calibration(data["residuals_check_seeds"], data["history"], args.out / "calibration.png",
+                     data["residuals_ensemble_seeds"], len(data["ensemble_seeds"]))
     print(calibrate.format_residuals(data))
     print(f"wrote {path} and {args.out / 'calibration.png'} ({result.evaluations} evaluations, "
           f"{result.wall_time:.0f} s)")

@@ -12,8 +12,10 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathlib.Path) -> None:
-    """Bars of RMSE (twin with its std over seeds, experiment with its std) per cell, and the cost per evaluation."""
+def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathlib.Path,
+                     ensemble_rows: Sequence[dict] = (), ensemble_size: int = 0) -> None:
+    """Bars of RMSE (twin with its std over seeds, experiment with its std) per cell, each cell's 20 % bar,
+    the twin's mean over a larger ensemble of seeds as a marker where given, and the cost per evaluation."""
     fig, (bars, trace) = plt.subplots(1, 2, figsize=(12, 4.5), gridspec_kw={"width_ratios": [3, 1]})
     x = np.arange(len(rows))
     labels = [f"{r['controller']}\nT{r['trajectory']}" for r in rows]
@@ -27,6 +29,9 @@ def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathli
                           label="experiment ± 20 % (the issue's bar)" if xi == 0 else None)
         bars.annotate(f"{100 * (r['ratio'] - 1):+.0f}%", (xi + 0.2, r["twin_rmse_deg"] + r["twin_std_deg"]),
                       ha="center", va="bottom", fontsize=7, xytext=(0, 3), textcoords="offset points")
+    if ensemble_rows:
+        bars.plot(x + 0.2, [r["twin_rmse_deg"] for r in ensemble_rows], "kD", ms=4,
+                  label=f"as-built twin, mean of {ensemble_size} seeds")
     bars.set_xticks(x, labels, fontsize=8)
     bars.set_ylabel("RMSE (deg), mean of 5 seeds")
     bars.legend(fontsize=8)
