@@ -131,7 +131,7 @@ def test_same_seeds_same_fit_whatever_the_workers():
 
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluations (the fixed starting simplex) cost
-    exactly what the committed file says. The whole fit (100 evaluations, about 4 min on 2 cores) is
+    exactly what the committed file says. The whole fit (100 evaluations, about 6 min on 2 cores) is
     ``twin calibrate --out DIR``; its file equals the committed one (see README, as-built)."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, max_evaluations=3, check_seeds=(), ensemble_seeds=())

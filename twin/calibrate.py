@@ -37,6 +37,7 @@ from twin.as_built import ASSUMED, FITTED, as_built_plant
 from twin.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG
 from twin.scenario import Scenario
 from twin.sweep import code_version
+from twin.tables import sample_std
 
 CELLS = tuple((c, t) for c, row in THESIS_EXPERIMENT_RMSE_DEG.items() for t in row)
 SSE_WEIGHT = 0.25
@@ -183,17 +184,14 @@ def calibrate(*, workers: int = 2, max_evaluations: int = MAX_EVALUATIONS, fit_s
                  options={"initial_simplex": simplex, "maxfev": max_evaluations, "xatol": 0.02, "fatol": 1e-3})
         best_key = min(seen, key=lambda k: seen[k][0])
         best = values_at(best_key)
-        check_cells, ensemble_cells = (_cells_once(best, seeds, workers) for seeds in (check_seeds, ensemble_seeds))
+        same_as_fit = tuple(check_seeds) == tuple(fit_seeds)  # then the fit has already run them
+        check_cells = seen[best_key][1] if same_as_fit else _cells_once(best, check_seeds, workers)
+        ensemble_cells = _cells_once(best, ensemble_seeds, workers)
     finally:
         evaluator.close()
     return Calibration(values=best, cost=seen[best_key][0], evaluations=len(history), history=history,
                        fit_cells=seen[best_key][1], check_cells=check_cells, ensemble_cells=ensemble_cells,
                        wall_time=time.perf_counter() - started)
-
-
-def sample_std(values: Sequence[float]) -> float:
-    """The std of runs as the thesis's tables give it (ddof 1, as ``twin.tables``); 0 for a single run."""
-    return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
 
 
 def cell_rows(cells: Sequence[CellResult]) -> list[dict]:

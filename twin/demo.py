@@ -25,6 +25,7 @@ from twin.reference import (
 from twin.runner import run_many
 from twin.scenario import CONTROLLER_NAMES, TRAJECTORY_NUMBERS, Scenario
 from twin.simulation import Result
+from twin.tables import sample_std
 
 LABELS = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
 
@@ -47,7 +48,7 @@ def summary_rows(results: list[Result]) -> list[dict]:
             thesis = THESIS_SIMULATED_RMSE_DEG.get(c, {}).get(t)
             rows.append({
                 "controller": c, "trajectory": t, "runs": len(records),
-                "rmse_mean": rmse.mean(), "rmse_std": rmse.std(ddof=1) if len(rmse) > 1 else 0.0,
+                "rmse_mean": rmse.mean(), "rmse_std": sample_std(rmse),
                 "sse_mean": sse.mean(), "sse_min": sse.min(), "sse_max": sse.max(),
                 "max_error_mean": peak.mean(), "thesis_rmse": thesis,
                 "thesis_sse": THESIS_SIMULATED_SSE_T1_DEG.get(c) if t == 1 else None,

@@ -17,6 +17,11 @@ SUMMARY_COLUMNS = GROUP_BY + ("runs", "failed", "rmse_mean_deg", "rmse_std_deg",
                               "sse_mean_deg", "sse_min_deg", "sse_max_deg", "max_error_deg")
 
 
+def sample_std(values: Sequence[float]) -> float:
+    """The std of runs as the thesis's tables give it (ddof 1); 0 for a single run."""
+    return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
+
+
 def write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
     """``rows`` as CSV with ``columns`` (lists joined with ';', None empty), written whole or not at all."""
     tmp = path.with_suffix(path.suffix + ".tmp")
@@ -50,7 +55,7 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
         sse = np.array([math.nan if r["sse_deg"] is None else r["sse_deg"] for r in ok]) if ok else np.array([math.nan])
         summary.append({
             **dict(zip(GROUP_BY, key, strict=True)), "runs": len(members), "failed": len(members) - len(ok),
-            "rmse_mean_deg": float(np.mean(rmse)), "rmse_std_deg": float(np.std(rmse, ddof=1)) if len(ok) > 1 else 0.0,
+            "rmse_mean_deg": float(np.mean(rmse)), "rmse_std_deg": sample_std(rmse),
             "rmse_min_deg": float(np.min(rmse)), "rmse_max_deg": float(np.max(rmse)),
             "sse_mean_deg": float(np.mean(sse)), "sse_min_deg": float(np.min(sse)), "sse_max_deg": float(np.max(sse)),
             "max_error_deg": float(max((r["max_error_deg"] for r in ok), default=math.nan)),
