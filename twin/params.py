@@ -216,7 +216,7 @@ class ChamberParams:
     initial_pressure_fraction: float = 0.5  # of the supply, in both chambers at the start (*assumed*: the
     # thesis pre-charges by moving the joint side to side; shut valves then trap a middle pressure)
     atmospheric_pressure: float = 101.325e3  # Pa
-    substeps: int = 400  # implicit sub-steps of the chamber/rack/supply model per physics tick
+    substeps: int = 100  # implicit sub-steps of the chamber/rack/supply model per physics tick (10 us)
 
     def __post_init__(self) -> None:
         _require_positive(self, "water_bulk_modulus", "dead_volume", "atmospheric_pressure")
