@@ -119,6 +119,25 @@ def test_a_value_outside_its_bounds_is_refused(tmp_path):
         calibrated_values(path)
 
 
+def test_sse_range_is_the_largest_of_five_runs_averaged_over_groups_of_five():
+    five = CellResult("ffpva", 1, (1.0,) * 5, (0.1, -0.4, 0.2, math.nan, 0.3), 0)
+    assert five.sse_range == pytest.approx(0.4)  # the thesis's "+-": the largest |SSE| of the five
+    ten = CellResult("ffpva", 1, (1.0,) * 10, (0.1, -0.4, 0.2, 0.0, 0.3, 0.9, 0.1, 0.1, -0.2, 0.0), 0)
+    assert ten.sse_range == pytest.approx((0.4 + 0.9) / 2)  # not 0.9, the largest of ten
+    assert CellResult("smc", 1, (1.0,) * 3, (0.2, -0.5, 0.1), 0).sse_range == pytest.approx(0.5)  # fewer than 5
+    assert math.isnan(CellResult("smc", 1, (1.0,) * 5, (math.nan,) * 5, 0).sse_range)
+
+
+def test_cells_of_picks_the_runs_of_the_wanted_seeds():
+    cell = CellResult("pva", 2, (1.0, 2.0, 3.0, 4.0), (0.1, 0.2, 0.3, 0.4), 2, seeds=(0, 1, 2, 3),
+                      failed_seeds=(1, 3))
+    (picked,) = calibrate._cells_of([cell], (3, 0))
+    assert picked.seeds == (0, 3) and picked.rmse_deg == (1.0, 4.0) and picked.sse_deg == (0.1, 0.4)
+    assert picked.failed == 1 and picked.failed_seeds == (3,)
+    assert calibrate._cells_of([cell], (0, 4)) == []  # seed 4 was not run: the caller runs them
+    assert calibrate._cells_of([cell], ()) == []
+
+
 def test_same_seeds_same_fit_whatever_the_workers():
     small = dict(max_evaluations=2, fit_seeds=(0, 1, 2), check_seeds=(0,), ensemble_seeds=(1,))
     one = calibrate.calibrate(workers=1, **small)
@@ -127,11 +146,16 @@ def test_same_seeds_same_fit_whatever_the_workers():
     assert [c.rmse_deg for c in one.check_cells] == [c.rmse_deg for c in two.check_cells]
     assert [c.rmse_deg for c in one.ensemble_cells] == [c.rmse_deg for c in two.ensemble_cells]
     assert len(one.ensemble_cells) == len(calibrate.CELLS)
+    # The check seed 0 is one of the fit's: its cells are cut from the fit's runs, and equal a run of seed 0
+    # alone; the ensemble seed 1 is too.
+    alone = calibrate.Evaluator(seeds=(0, 1), workers=1).cells(one.values)
+    assert [c.rmse_deg for c in one.check_cells] == [c.rmse_deg[:1] for c in alone]
+    assert [c.rmse_deg for c in one.ensemble_cells] == [c.rmse_deg[1:] for c in alone]
 
 
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluations (the fixed starting simplex) cost
-    exactly what the committed file says. The whole fit (100 evaluations, about 6 min on 2 cores) is
+    exactly what the committed file says. The whole fit (100 evaluations, about 8 min on 2 cores) is
     ``twin calibrate --out DIR``; its file equals the committed one (see README, as-built)."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, max_evaluations=3, check_seeds=(), ensemble_seeds=())

@@ -191,7 +191,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
                             check_seeds=calibrate.CHECK_SEEDS, ensemble_seeds=calibrate.ENSEMBLE_SEEDS)
     path = calibrate.write(data, args.out)
     plot_calibration(data["residuals_check_seeds"], data["history"], args.out / "calibration.png",
-                     data["residuals_ensemble_seeds"], len(data["ensemble_seeds"]))
+                     data["residuals_ensemble_seeds"], len(data["ensemble_seeds"]), len(data["check_seeds"]))
     print(calibrate.format_residuals(data))
     print(f"wrote {path} and {args.out / 'calibration.png'} ({result.evaluations} evaluations, "
           f"{result.wall_time:.0f} s)")

@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 
 
 def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathlib.Path,
-                     ensemble_rows: Sequence[dict] = (), ensemble_size: int = 0) -> None:
+                     ensemble_rows: Sequence[dict] = (), ensemble_size: int = 0, check_size: int = 5) -> None:
     """Bars of RMSE (twin with its std over seeds, experiment with its std) per cell, each cell's 20 % bar,
     the twin's mean over a larger ensemble of seeds as a marker where given, and the cost per evaluation."""
     fig, (bars, trace) = plt.subplots(1, 2, figsize=(12, 4.5), gridspec_kw={"width_ratios": [3, 1]})
@@ -22,7 +22,7 @@ def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathli
     bars.bar(x - 0.2, [r["experiment_rmse_deg"] for r in rows], 0.4, yerr=[r["experiment_std_deg"] for r in rows],
              label="experiment (thesis §8)", color="0.6", capsize=3)
     bars.bar(x + 0.2, [r["twin_rmse_deg"] for r in rows], 0.4, yerr=[r["twin_std_deg"] for r in rows],
-             label="as-built twin", color="tab:blue", capsize=3)
+             label=f"as-built twin, mean of {check_size} seeds", color="tab:blue", capsize=3)
     for xi, r in zip(x, rows, strict=True):
         target = r["experiment_rmse_deg"]
         bars.fill_between([xi, xi + 0.4], 0.8 * target, 1.2 * target, color="tab:green", alpha=0.25, lw=0,
@@ -33,7 +33,7 @@ def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathli
         bars.plot(x + 0.2, [r["twin_rmse_deg"] for r in ensemble_rows], "kD", ms=4,
                   label=f"as-built twin, mean of {ensemble_size} seeds")
     bars.set_xticks(x, labels, fontsize=8)
-    bars.set_ylabel("RMSE (deg), mean of 5 seeds")
+    bars.set_ylabel("RMSE (deg)")
     bars.legend(fontsize=8)
     bars.set_title("as-built calibration: RMSE per cell")
     trace.plot(np.arange(1, len(history) + 1), [h["cost"] for h in history], ".-", lw=0.8)
