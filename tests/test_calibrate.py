@@ -87,7 +87,7 @@ def test_record_keeps_the_ensemble_and_the_table_and_plot_show_it(tmp_path):
     assert "20 seeds: twin/exp" in table.splitlines()[0]
     assert table.splitlines()[len(calibrate.CELLS)].split()[-1] == "0.75"  # the last cell is sliding mode T4
     plot_calibration(data["residuals_check_seeds"], data["history"], tmp_path / "c.png",
-                     data["residuals_ensemble_seeds"], 20)
+                     data["residuals_ensemble_seeds"], 20, 1)
     assert (tmp_path / "c.png").stat().st_size > 0
 
 
@@ -125,6 +125,10 @@ def test_sse_range_is_the_largest_of_five_runs_averaged_over_groups_of_five():
     ten = CellResult("ffpva", 1, (1.0,) * 10, (0.1, -0.4, 0.2, 0.0, 0.3, 0.9, 0.1, 0.1, -0.2, 0.0), 0)
     assert ten.sse_range == pytest.approx((0.4 + 0.9) / 2)  # not 0.9, the largest of ten
     assert CellResult("smc", 1, (1.0,) * 3, (0.2, -0.5, 0.1), 0).sse_range == pytest.approx(0.5)  # fewer than 5
+    seven = CellResult("smc", 1, (1.0,) * 7, (0.1, 0.2, 0.3, 0.4, 0.5, 9.0, 9.0), 0)
+    assert seven.sse_range == pytest.approx(0.5)  # the two runs past the whole group are left out
+    moving = CellResult("smc", 1, (1.0,) * 10, (math.nan,) * 5 + (0.1, 0.2, 0.3, -0.6, 0.0), 0)
+    assert moving.sse_range == pytest.approx(0.6)  # a group whose runs all end moving has no range
     assert math.isnan(CellResult("smc", 1, (1.0,) * 5, (math.nan,) * 5, 0).sse_range)
 
 
@@ -136,10 +140,18 @@ def test_cells_of_picks_the_runs_of_the_wanted_seeds():
     assert picked.failed == 1 and picked.failed_seeds == (3,)
     assert calibrate._cells_of([cell], (0, 4)) == []  # seed 4 was not run: the caller runs them
     assert calibrate._cells_of([cell], ()) == []
+    (twice,) = calibrate._cells_of([cell], (3, 3))
+    assert twice.rmse_deg == (4.0,) and twice.failed == 1  # a seed asked for twice is one run
+    with pytest.raises(ValueError, match="without their seeds"):
+        calibrate._cells_of([CellResult("pva", 2, (1.0,), (0.1,), 1, seeds=(0,))], (0,))
 
 
-def test_same_seeds_same_fit_whatever_the_workers():
+def test_same_seeds_same_fit_whatever_the_workers(monkeypatch):
     small = dict(max_evaluations=2, fit_seeds=(0, 1, 2), check_seeds=(0,), ensemble_seeds=(1,))
+    def no_new_runs(*args):
+        raise AssertionError("the check and ensemble seeds are fit seeds: their runs are the fit's")
+
+    monkeypatch.setattr(calibrate, "_cells_once", no_new_runs)
     one = calibrate.calibrate(workers=1, **small)
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost

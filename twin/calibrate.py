@@ -8,10 +8,10 @@ each controller. Residuals::
     r = ln(RMSE_twin / RMSE_exp)                  per cell
     r = sqrt(SSE_WEIGHT) * ln(range_twin / range_exp)  per controller (T1)
 
-with RMSE_twin the mean over the ensemble's noise seeds (:data:`FIT_SEEDS`: twenty,
-so the fit sees the twin's expected five-run mean rather than one noisy draw of it)
+with RMSE_twin the mean over the fit's noise seeds (:data:`FIT_SEEDS`: twenty, so
+the fit sees the twin's expected five-run mean rather than one noisy draw of it)
 and range_twin the largest |SSE| of T1 among five runs (the thesis's "+-"),
-averaged over the seeds taken five at a time. Cost: the Cauchy loss
+averaged over the seeds taken five at a time (:attr:`CellResult.sse_range`). Cost: the Cauchy loss
 ``sum of c^2 ln(1 + (r / c)^2)`` with its scale c at the issue's tolerance,
 ln 1.2. Near the table it is the sum of r^2; a residual many tolerances out
 (a cell no plausible parameter reaches, such as PVA T1) pulls with an
@@ -47,7 +47,7 @@ SSE_WEIGHT = 0.25
 LOSS_SCALE = math.log(1.2)  # the Cauchy loss's scale: the issue's "within 20 %"
 FIT_SEEDS = tuple(range(20))  # noise seeds the fit sees: the expected five-run mean, not one draw of it
 CHECK_SEEDS = (0, 1, 2, 3, 4)  # the thesis's five runs, for the residual table
-ENSEMBLE_SEEDS = tuple(range(20))  # the twin's expected five-run mean, less its seed noise
+ENSEMBLE_SEEDS = tuple(range(20))  # the twin's expected five-run mean (now the fit's own seeds, so in-sample)
 MAX_EVALUATIONS = 100
 FILE_VERSION = 3  # 2: the ensemble-seed residuals; 3: SSE ranges of more than five seeds are five-run means
 
@@ -69,7 +69,10 @@ class CellResult:
     @property
     def sse_range(self) -> float:
         """The thesis's "+-": the largest |SSE| of five runs. With more seeds, its mean over the runs
-        taken five at a time (the largest of twenty runs would overstate what five runs show)."""
+        taken five at a time in seed order (the largest of twenty runs would overstate what five runs
+        show); a last group of fewer than five is left out. With fewer than five runs in all, the
+        largest of those (which understates a five-run range). Groups whose runs all end moving
+        (nan) are left out; nan if all do."""
         groups = [self.sse_deg[i:i + THESIS_RUNS] for i in range(0, len(self.sse_deg), THESIS_RUNS)]
         whole = [g for g in groups if len(g) == THESIS_RUNS] or groups
         ranges = [float(np.nanmax(np.abs(g))) for g in whole if not all(math.isnan(s) for s in g)]
@@ -134,15 +137,18 @@ def _cells_once(values: dict[str, float], seeds: Sequence[int], workers: int) ->
 def _cells_of(cells: Sequence[CellResult], wanted: Sequence[int]) -> list[CellResult]:
     """``cells`` cut down to the ``wanted`` seeds, or [] if they did not run them all: the runs are
     deterministic, so the fit's own runs serve for any subset of its seeds."""
+    wanted = sorted(set(wanted))
     if not wanted or not all(set(wanted) <= set(cell.seeds) for cell in cells):
         return []
     picked = []
     for cell in cells:
-        keep = [cell.seeds.index(s) for s in sorted(wanted)]
+        if len(cell.failed_seeds) != cell.failed:
+            raise ValueError(f"{cell.controller} T{cell.trajectory}: failed runs without their seeds")
+        keep = [cell.seeds.index(s) for s in wanted]
         failed = tuple(s for s in cell.failed_seeds if s in wanted)
         picked.append(dataclasses.replace(cell, rmse_deg=tuple(cell.rmse_deg[i] for i in keep),
                                           sse_deg=tuple(cell.sse_deg[i] for i in keep), failed=len(failed),
-                                          seeds=tuple(sorted(wanted)), failed_seeds=failed))
+                                          seeds=tuple(wanted), failed_seeds=failed))
     return picked
 
 

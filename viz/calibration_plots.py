@@ -13,7 +13,7 @@ import numpy as np  # noqa: E402
 
 
 def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathlib.Path,
-                     ensemble_rows: Sequence[dict] = (), ensemble_size: int = 0, check_size: int = 5) -> None:
+                     ensemble_rows: Sequence[dict], ensemble_size: int, check_size: int) -> None:
     """Bars of RMSE (twin with its std over seeds, experiment with its std) per cell, each cell's 20 % bar,
     the twin's mean over a larger ensemble of seeds as a marker where given, and the cost per evaluation."""
     fig, (bars, trace) = plt.subplots(1, 2, figsize=(12, 4.5), gridspec_kw={"width_ratios": [3, 1]})
