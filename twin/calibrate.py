@@ -58,9 +58,12 @@ class CellResult:
     trajectory: int
     rmse_deg: tuple[float, ...]  # per seed
     sse_deg: tuple[float, ...]  # per seed (nan when the trajectory ends moving)
-    failed: int  # runs with warnings
-    seeds: tuple[int, ...] = ()  # of rmse_deg and sse_deg, in order
     failed_seeds: tuple[int, ...] = ()  # the seeds of the runs with warnings
+    seeds: tuple[int, ...] = ()  # of rmse_deg and sse_deg, in order
+
+    @property
+    def failed(self) -> int:
+        return len(self.failed_seeds)
 
     @property
     def mean_rmse(self) -> float:
@@ -120,8 +123,8 @@ class Evaluator:
         for controller, trajectory, seed, rmse, sse, failed in sorted(rows, key=lambda row: row[:3]):
             found.setdefault((controller, trajectory), []).append((seed, rmse, sse, failed))
         return [CellResult(c, t, tuple(r for _, r, _, _ in found[c, t]), tuple(s for _, _, s, _ in found[c, t]),
-                           sum(f for *_, f in found[c, t]), seeds=tuple(seed for seed, *_ in found[c, t]),
-                           failed_seeds=tuple(seed for seed, *_, f in found[c, t] if f)) for c, t in CELLS]
+                           failed_seeds=tuple(seed for seed, *_, f in found[c, t] if f),
+                           seeds=tuple(seed for seed, *_ in found[c, t])) for c, t in CELLS]
 
 
 def _cells_once(values: dict[str, float], seeds: Sequence[int], workers: int) -> list[CellResult]:
@@ -142,13 +145,10 @@ def _cells_of(cells: Sequence[CellResult], wanted: Sequence[int]) -> list[CellRe
         return []
     picked = []
     for cell in cells:
-        if len(cell.failed_seeds) != cell.failed:
-            raise ValueError(f"{cell.controller} T{cell.trajectory}: failed runs without their seeds")
         keep = [cell.seeds.index(s) for s in wanted]
-        failed = tuple(s for s in cell.failed_seeds if s in wanted)
         picked.append(dataclasses.replace(cell, rmse_deg=tuple(cell.rmse_deg[i] for i in keep),
-                                          sse_deg=tuple(cell.sse_deg[i] for i in keep), failed=len(failed),
-                                          seeds=tuple(wanted), failed_seeds=failed))
+                                          sse_deg=tuple(cell.sse_deg[i] for i in keep), seeds=tuple(wanted),
+                                          failed_seeds=tuple(s for s in cell.failed_seeds if s in wanted)))
     return picked
 
 
