@@ -79,8 +79,9 @@ def test_record_keeps_the_ensemble_and_the_table_and_plot_show_it(tmp_path):
     result = calibrate.Calibration(values=calibrated_values(), cost=0.0, evaluations=1,
                                    history=[(calibrated_values(), 0.5)], fit_cells=exact_cells(),
                                    check_cells=exact_cells(), ensemble_cells=exact_cells({("smc", 4): 0.75}),
-                                   wall_time=1.0)
-    data = calibrate.record(result, max_evaluations=1, fit_seeds=(0,), check_seeds=(0,), ensemble_seeds=range(20))
+                                   wall_time=1.0, max_evaluations=1, fit_seeds=(0,), check_seeds=(0,),
+                                   ensemble_seeds=tuple(range(20)))
+    data = calibrate.record(result)
     assert data["ensemble_seeds"] == list(range(20))
     (smc_t4,) = [r for r in data["residuals_ensemble_seeds"] if (r["controller"], r["trajectory"]) == ("smc", 4)]
     assert smc_t4["ratio"] == pytest.approx(0.75)

@@ -185,6 +185,10 @@ class Calibration:
     check_cells: list[CellResult]
     ensemble_cells: list[CellResult]  # empty when no ensemble seeds were asked for
     wall_time: float
+    max_evaluations: int
+    fit_seeds: tuple[int, ...]
+    check_seeds: tuple[int, ...]
+    ensemble_seeds: tuple[int, ...]
 
 
 def calibrate(*, workers: int = 2, max_evaluations: int = MAX_EVALUATIONS, fit_seeds: Sequence[int] = FIT_SEEDS,
@@ -222,8 +226,10 @@ def calibrate(*, workers: int = 2, max_evaluations: int = MAX_EVALUATIONS, fit_s
     finally:
         evaluator.close()
     return Calibration(values=best, cost=seen[best_key][0], evaluations=len(history), history=history,
-                       fit_cells=seen[best_key][1], check_cells=check_cells, ensemble_cells=ensemble_cells,
-                       wall_time=time.perf_counter() - started)
+                       fit_cells=fit_cells, check_cells=check_cells, ensemble_cells=ensemble_cells,
+                       wall_time=time.perf_counter() - started, max_evaluations=max_evaluations,
+                       fit_seeds=tuple(fit_seeds), check_seeds=tuple(check_seeds),
+                       ensemble_seeds=tuple(ensemble_seeds))
 
 
 def cell_rows(cells: Sequence[CellResult]) -> list[dict]:
@@ -242,14 +248,13 @@ def cell_rows(cells: Sequence[CellResult]) -> list[dict]:
     return rows
 
 
-def record(result: Calibration, *, max_evaluations: int, fit_seeds: Sequence[int],
-           check_seeds: Sequence[int], ensemble_seeds: Sequence[int]) -> dict:
+def record(result: Calibration) -> dict:
     """The versioned data file's content."""
     return {
         "version": FILE_VERSION,
         "code_version": code_version(),
-        "made_by": f"twin calibrate (Nelder-Mead, at most {max_evaluations} evaluations, fit seeds "
-                   f"{list(fit_seeds)})",
+        "made_by": f"twin calibrate (Nelder-Mead, at most {result.max_evaluations} evaluations, fit seeds "
+                   f"{list(result.fit_seeds)})",
         "loss": f"Cauchy, scale ln 1.2 = {LOSS_SCALE:.4f}; SSE-range residuals weighted sqrt({SSE_WEIGHT})",
         "fitted": dict(result.values),  # full precision: the preset is exactly what was scored
         "bounds": {f.name: {"low": f.low, "high": f.high, "unit": f.unit, "why": f.why} for f in FITTED},
@@ -259,9 +264,9 @@ def record(result: Calibration, *, max_evaluations: int, fit_seeds: Sequence[int
         "wall_time_s": round(result.wall_time, 1),
         "residuals_fit_seeds": cell_rows(result.fit_cells),
         "residuals_check_seeds": cell_rows(result.check_cells),
-        "check_seeds": list(check_seeds),
+        "check_seeds": list(result.check_seeds),
         "residuals_ensemble_seeds": cell_rows(result.ensemble_cells),
-        "ensemble_seeds": list(ensemble_seeds),
+        "ensemble_seeds": list(result.ensemble_seeds),
         "history": [{"values": dict(values), "cost": c}
                     for values, c in result.history],
     }

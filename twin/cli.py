@@ -187,8 +187,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
     if args.max_evaluations is None:
         args.max_evaluations = calibrate.MAX_EVALUATIONS
     result = calibrate.calibrate(workers=args.workers, max_evaluations=args.max_evaluations, progress=progress)
-    data = calibrate.record(result, max_evaluations=args.max_evaluations, fit_seeds=calibrate.FIT_SEEDS,
-                            check_seeds=calibrate.CHECK_SEEDS, ensemble_seeds=calibrate.ENSEMBLE_SEEDS)
+    data = calibrate.record(result)
     path = calibrate.write(data, args.out)
     plot_calibration(data["residuals_check_seeds"], data["history"], args.out / "calibration.png",
                      data["residuals_ensemble_seeds"], len(data["ensemble_seeds"]), len(data["check_seeds"]))
