@@ -25,8 +25,8 @@ import dataclasses
 
 import numpy as np
 
-from twin import friction
-from twin.params import NOMINAL_PARAMS, FrictionParams, JointParams, ValveParams
+from twin.physics import friction
+from twin.physics.params import NOMINAL_PARAMS, FrictionParams, JointParams, ValveParams
 
 
 @dataclasses.dataclass(frozen=True)

@@ -15,7 +15,7 @@ import numpy as np
 
 from controllers.feedforward import NominalModel, feedforward_duty
 from controllers.pva import PWM_PERIOD, PVAGains, check_period, pva_duty
-from twin.control import Measurement, Setpoint
+from twin.sim.control import Measurement, Setpoint
 
 KP_BY_GAIN_SET = {"simulation": 50_000.0, "experiment": 45_000.0}
 

@@ -14,8 +14,8 @@ from collections.abc import Callable
 import numpy as np
 
 from controllers.pva import PWM_PERIOD, check_period
-from twin.control import Measurement, Setpoint
 from twin.exceptions import InvalidController
+from twin.sim.control import Measurement, Setpoint
 
 
 @dataclasses.dataclass

@@ -1,8 +1,8 @@
-"""A controller as a policy for :mod:`twin.env`: observation in, duty out.
+"""A controller as a policy for :mod:`twin.envs.environment`: observation in, duty out.
 
 The controller is called every time the policy is, so the environment's action
 period must equal the controller's period (16 ms for PVA and FF + PVA, 1 ms for
-sliding mode): ``twin.env.load(..., action_period=controller.period)``. The
+sliding mode): ``twin.envs.environment.load(..., action_period=controller.period)``. The
 policy checks this on every call against the observed episode time and raises
 :class:`~twin.exceptions.InvalidScenario` at the first step that disagrees; the
 controller's clock is the environment's.
@@ -15,8 +15,8 @@ import dataclasses
 import dm_env
 import numpy as np
 
-from twin.control import Controller, Measurement, Setpoint
 from twin.exceptions import InvalidScenario
+from twin.sim.control import Controller, Measurement, Setpoint
 
 TIME_TOLERANCE = 1e-9  # s, far below the 1 ms tick
 

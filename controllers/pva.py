@@ -15,9 +15,9 @@ import dataclasses
 
 import numpy as np
 
-from twin.control import Measurement, Setpoint
 from twin.exceptions import InvalidController
-from twin.ticks import whole_ticks
+from twin.physics.ticks import whole_ticks
+from twin.sim.control import Measurement, Setpoint
 
 PWM_PERIOD = 16e-3  # s, the controller runs once per PWM period (§6)
 

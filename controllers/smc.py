@@ -20,8 +20,8 @@ import numpy as np
 from controllers.feedforward import NominalModel
 from controllers.ffpva import ffpva_duty
 from controllers.pva import PWM_PERIOD, PVAGains, check_period
-from twin.control import Measurement, Setpoint
 from twin.exceptions import InvalidController
+from twin.sim.control import Measurement, Setpoint
 
 SWITCHING_PERIOD = 1e-3  # s
 LAMBDA_BY_GAIN_SET = {"simulation": 80.0, "experiment": 40.0}  # 1/s

@@ -9,12 +9,12 @@ import pathlib
 import pytest
 
 from controllers.open_loop import OpenLoop
-from twin.model import Orientation
-from twin.params import FrictionParams, JointParams, ValveParams
+from twin.physics.model import Orientation
+from twin.physics.params import FrictionParams, JointParams, ValveParams
+from twin.physics.valves import ValveModel
 from twin.plants import PLANTS, Plant
-from twin.scenario import Scenario
-from twin.simulation import Result, simulate
-from twin.valves import ValveModel
+from twin.sim.scenario import Scenario
+from twin.sim.simulation import Result, simulate
 
 R_SPUR = JointParams().gears.spur_radius  # m
 AREA = JointParams().cylinder.bore_area  # m^2

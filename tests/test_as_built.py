@@ -1,4 +1,4 @@
-"""The as-built plant's effects (twin.chambers, twin.stiction_map, twin.as_built) against closed forms.
+"""The as-built plant's effects (twin.physics.chambers, twin.physics.stiction_map, twin.plants.as_built) against closed forms.
 
 Chambers (§3): pressure build-up through one valve, the hydraulic natural
 frequency of two sealed chambers. Friction (§4): breakaway at the mapped
@@ -19,21 +19,21 @@ import pytest
 from conftest import AREA, R_SPUR, open_loop
 
 from controllers.open_loop import OpenLoop
-from twin import hydraulics
-from twin.as_built import EFFECTS, as_built_plant
-from twin.chambers import CompressibleCircuit
+from twin.envs.runner import run, run_many
 from twin.exceptions import InvalidScenario
-from twin.hall import HallReading
-from twin.params import ChamberParams, FrictionParams, StictionMapParams, SupplyLineParams, ValveParams
+from twin.physics import hydraulics
+from twin.physics.chambers import CompressibleCircuit
+from twin.physics.hall import HallReading
+from twin.physics.params import ChamberParams, FrictionParams, StictionMapParams, SupplyLineParams, ValveParams
+from twin.physics.stiction_map import StictionMap
 from twin.plants import PLANTS
-from twin.runner import run, run_many
-from twin.scenario import Scenario
-from twin.simulation import Result, simulate
-from twin.stiction_map import StictionMap
+from twin.plants.as_built import EFFECTS, as_built_plant
+from twin.sim.scenario import Scenario
+from twin.sim.simulation import Result, simulate
 
 H = 1e-3  # s, physics tick
 STROKE = (-2.494e-3, 17.457e-3)  # m, rack A's joint range in the compiled model
-MASS = 0.0435  # kg, the train's effective mass referred to the rack (twin.model)
+MASS = 0.0435  # kg, the train's effective mass referred to the rack (twin.physics.model)
 BETA = ChamberParams().water_bulk_modulus  # Pa
 DEAD_VOLUME = ChamberParams().dead_volume  # m^3
 G_OPEN = 1.0 / ValveParams().open_resistance  # m^3/(Pa s), a valve fully on (eq. 4.4.2 at 100 %)

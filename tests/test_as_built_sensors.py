@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from twin.exceptions import InvalidParameter
-from twin.hall import HallReading, fit_degrees, reading_error, true_volts
-from twin.params import HallParams, StictionMapParams
-from twin.stiction_map import StictionMap
+from twin.physics.hall import HallReading, fit_degrees, reading_error, true_volts
+from twin.physics.params import HallParams, StictionMapParams
+from twin.physics.stiction_map import StictionMap
 
 R_SPUR = 9.525e-3 / 2  # m, spur pitch radius (§2)
 A, B, C = -9.122, -25.58, 244.94  # eq. 4.2.1, deg from V
@@ -170,7 +170,7 @@ def test_stiction_map_rejects_bad_arguments(base, stroke):
 
 
 def test_stiction_maps_evaluate_each_runs_own_map():
-    from twin.stiction_map import StictionMaps
+    from twin.physics.stiction_map import StictionMaps
 
     params = StictionMapParams(scatter=1.0, knot_spacing=1e-3)
     maps = StictionMaps(params, 2.0, STROKE, seeds=[(0, 1), (1, 1), (0, 1)])
@@ -187,8 +187,8 @@ def test_run_plot_shows_the_scored_reading_beside_the_true_angle(tmp_path, monke
     """On a plant scored on the Hall reading the figure must show what was scored, not only the true angle."""
     import matplotlib.figure
 
-    from twin.runner import run
-    from twin.scenario import Scenario
+    from twin.envs.runner import run
+    from twin.sim.scenario import Scenario
     from viz.plots import plot_run
 
     drawn = []

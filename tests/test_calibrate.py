@@ -7,11 +7,11 @@ import math
 
 import pytest
 
-from twin import calibrate
-from twin.as_built import CALIBRATION_FILE, FITTED, as_built_plant, calibrated_values
-from twin.calibrate import CellResult, cost, values_at
 from twin.exceptions import InvalidScenario
-from twin.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG
+from twin.experiments import calibrate
+from twin.experiments.calibrate import CellResult, cost, values_at
+from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG
+from twin.plants.as_built import CALIBRATION_FILE, FITTED, as_built_plant, calibrated_values
 
 
 def exact_cells(scale: dict | None = None) -> list[CellResult]:

@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from twin.report import TRACE_COLUMNS
+from twin.sim.report import TRACE_COLUMNS
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 REQUIRED_KEYS = {"controller", "trajectory", "payload_g", "orientation", "plant", "seed", "rmse_deg",
@@ -130,10 +130,10 @@ def test_a_run_with_a_mujoco_warning_exits_1(monkeypatch, capsys):
     import dataclasses
 
     import twin.cli
-    import twin.runner
+    import twin.envs.runner
 
-    real = twin.runner.run
-    monkeypatch.setattr(twin.runner, "run", lambda s: dataclasses.replace(real(s), warnings=("mjWARN_BADQACC x1",)))
+    real = twin.envs.runner.run
+    monkeypatch.setattr(twin.envs.runner, "run", lambda s: dataclasses.replace(real(s), warnings=("mjWARN_BADQACC x1",)))
     assert twin.cli.main(["run", "--controller", "ffpva", "--trajectory", "2"]) == 1
     assert "mjWARN_BADQACC" in capsys.readouterr().out
 

@@ -10,13 +10,13 @@ import numpy as np
 import pytest
 
 from controllers.feedforward import NominalModel, feedforward_duty
-from twin import params as P
 from twin.exceptions import InvalidParameter, InvalidScenario
-from twin.friction import coulomb_force
-from twin.metrics import tracking_metrics
-from twin.params import FrictionParams, GearParams, ObserverParams
-from twin.sensing import FirstOrderObserver
-from twin.trajectories import trajectory
+from twin.physics import params as P
+from twin.physics.friction import coulomb_force
+from twin.physics.params import FrictionParams, GearParams, ObserverParams
+from twin.physics.sensing import FirstOrderObserver
+from twin.physics.trajectories import trajectory
+from twin.sim.metrics import tracking_metrics
 
 DT = 1e-3  # s, sensor sample period (§5)
 R_SPUR = 9.525e-3 / 2  # m, spur pitch radius (§2)
@@ -296,7 +296,7 @@ def test_feedforward_accounts_for_the_desired_acceleration():
 
 
 def test_a_contiguous_run_of_scenarios_is_selected_by_a_slice_and_others_by_their_indices():
-    from twin.scenario_axis import selector
+    from twin.physics.scenario_axis import selector
 
     assert selector(np.array([3, 4, 5])) == slice(3, 6)
     gappy = selector(np.array([0, 2, 3]))

@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from tests.conftest import open_loop
-from twin.model import Orientation, build_mjcf, compile_joint
+from twin.physics.model import Orientation, build_mjcf, compile_joint
 
 LIMIT_DEG = 0.01
 PAYLOAD = 13.5e-3

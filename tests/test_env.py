@@ -12,12 +12,12 @@ from dm_env import test_utils
 from controllers import make_controller
 from controllers.feedforward import NominalModel
 from controllers.policy import ControllerPolicy
-from twin import env as joint_env
+from twin.envs import env as joint_env
+from twin.envs.runner import run
 from twin.exceptions import InvalidScenario
-from twin.model import Orientation
-from twin.runner import run
-from twin.scenario import Scenario
-from twin.simulation import simulate
+from twin.physics.model import Orientation
+from twin.sim.scenario import Scenario
+from twin.sim.simulation import simulate
 
 OBSERVATION_SHAPES = {  # README "As a dm_control environment"
     "rack_position": (1,), "angle": (1,), "velocity": (1,), "acceleration": (1,), "supply_pressure": (1,),

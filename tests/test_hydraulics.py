@@ -7,8 +7,8 @@ import math
 import numpy as np
 import pytest
 
-from twin.hydraulics import circuit, rack_step
-from twin.params import FrictionParams
+from twin.physics.hydraulics import circuit, rack_step
+from twin.physics.params import FrictionParams
 
 AREA = math.pi * 0.002**2  # m^2, 4 mm bore (§2)
 P_WS = 300e3  # Pa

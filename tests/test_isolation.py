@@ -6,9 +6,9 @@ import concurrent.futures
 
 import numpy as np
 
-from twin.model import Orientation
-from twin.runner import run, run_many
-from twin.scenario import Scenario
+from twin.envs.runner import run, run_many
+from twin.physics.model import Orientation
+from twin.sim.scenario import Scenario
 
 A = Scenario("ffpva", 1, seed=0)
 B = Scenario("smc", 3, payload=13.5e-3, orientation=Orientation.VERTICAL, seed=1)

@@ -15,11 +15,11 @@ import tornado.websocket
 import umsgpack
 from conftest import listening_addresses
 
-from twin import live
-from twin.live import LiveJoint
-from twin.model import Orientation, compile_joint
-from twin.runner import run
-from twin.scenario import Scenario
+from twin.envs import live
+from twin.envs.live import LiveJoint
+from twin.envs.runner import run
+from twin.physics.model import Orientation, compile_joint
+from twin.sim.scenario import Scenario
 from viz import live_messages
 from viz.live_server import LiveSession, LiveViewer, ServerError
 from viz.recording import TraceRows, animation_command

@@ -7,8 +7,8 @@ import numpy as np
 import pytest
 
 from twin.exceptions import InvalidScenario
-from twin.model import MODEL_PATH, Orientation, compile_joint
-from twin.params import JointParams
+from twin.physics.model import MODEL_PATH, Orientation, compile_joint
+from twin.physics.params import JointParams
 
 OBJECTS = [mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_GEOM, mujoco.mjtObj.mjOBJ_SITE,
            mujoco.mjtObj.mjOBJ_ACTUATOR, mujoco.mjtObj.mjOBJ_SENSOR, mujoco.mjtObj.mjOBJ_EQUALITY,

@@ -11,12 +11,12 @@ import pytest
 from controllers import make_controller
 from controllers.feedforward import NominalModel
 from tests.conftest import AREA, R_SPUR, custom_plant, open_loop
-from twin.friction import coulomb_force
-from twin.model import Orientation, compile_joint
-from twin.params import FrictionParams, JointParams
-from twin.runner import thesis_controllers
-from twin.scenario import Scenario
-from twin.simulation import simulate
+from twin.envs.runner import thesis_controllers
+from twin.physics.friction import coulomb_force
+from twin.physics.model import Orientation, compile_joint
+from twin.physics.params import FrictionParams, JointParams
+from twin.sim.scenario import Scenario
+from twin.sim.simulation import simulate
 
 PARAMS = JointParams()
 G = PARAMS.gravity
@@ -188,7 +188,7 @@ def test_random_valve_commands_raise_no_mujoco_warning(plant):
 def test_a_mujoco_warning_is_reported_on_its_own_scenario_only(monkeypatch):
     """The smoke test above can only pass if warnings are read: a non-finite piston force in one scenario
     of a batch must come back as a MuJoCo warning on that scenario and not on its neighbour."""
-    from twin.plant_state import PlantState
+    from twin.sim.plant_state import PlantState
 
     real = PlantState.actuate
 

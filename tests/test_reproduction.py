@@ -12,9 +12,9 @@ import math
 import numpy as np
 import pytest
 
-from twin.reference import THESIS_SIMULATED_RMSE_DEG
-from twin.runner import run_many
-from twin.scenario import Scenario
+from twin.envs.runner import run_many
+from twin.experiments.reference import THESIS_SIMULATED_RMSE_DEG
+from twin.sim.scenario import Scenario
 
 SEEDS = range(5)
 TOLERANCE_DEG = 0.35  # issue "The twin, end to end"

@@ -16,12 +16,12 @@ import numpy as np
 import pytest
 
 from controllers.open_loop import ReversingSine
-from twin import ablation, studies
-from twin.as_built import EFFECTS, calibrated_values
-from twin.calibrate import CELLS, Evaluator
-from twin.control import Measurement, Setpoint
+from twin.experiments import ablation, studies
+from twin.experiments.calibrate import CELLS, Evaluator
+from twin.experiments.studies import Reversal, paired_reversals, reversal_lags
 from twin.plants import PLANTS
-from twin.studies import Reversal, paired_reversals, reversal_lags
+from twin.plants.as_built import EFFECTS, calibrated_values
+from twin.sim.control import Measurement, Setpoint
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
@@ -57,17 +57,17 @@ def test_default_plant_is_as_built_only_when_it_exists(monkeypatch):
 
 
 def test_reduced_robustness_run_writes_three_files_and_marks_a_failed_run(tmp_path, monkeypatch):
-    import twin.runner
+    import twin.envs.runner
     from viz.study_plots import plot_robustness
 
-    real = twin.runner.run_many
+    real = twin.envs.runner.run_many
 
     def with_a_warning(scenarios, **kwargs):  # one run raises a (fake) MuJoCo warning
         return [dataclasses.replace(r, warnings=("mjWARN_BADQACC x1",))
                 if (r.scenario.controller, r.scenario.payload, r.scenario.orientation.value)
                 == ("smc", 13.5e-3, "vertical") else r for r in real(scenarios, **kwargs)]
 
-    monkeypatch.setattr(twin.runner, "run_many", with_a_warning)
+    monkeypatch.setattr(twin.envs.runner, "run_many", with_a_warning)
     study = studies.robustness_study(out=tmp_path, plant_name="thesis", seeds=1, trajectories=(1,), workers=1)
     studies.write_robustness(study, tmp_path)
     plot_robustness(study.runs, tmp_path / "robustness.png")

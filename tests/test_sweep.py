@@ -14,10 +14,11 @@ import time
 
 import pytest
 
-from twin import cli, grid, sweep
+from twin import cli
+from twin.batch import grid, sweep
+from twin.batch.store import COLUMNS, ResultStore, StaleStore
+from twin.batch.sweep import WorkerLost, failed_record, make_chunks, run_chunk, run_sweep
 from twin.exceptions import InvalidScenario
-from twin.store import COLUMNS, ResultStore, StaleStore
-from twin.sweep import WorkerLost, failed_record, make_chunks, run_chunk, run_sweep
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 AXES = {"controller": ["ffpva", "smc"], "trajectory": [1, 2], "payload": [0.0, 13.5],
@@ -125,16 +126,16 @@ def test_rerun_skips_what_is_done(tmp_path):
 
 
 def _raise_on_seed(monkeypatch, seed: int, error: BaseException) -> None:
-    import twin.runner
+    import twin.envs.runner
 
-    real = twin.runner.run_many
+    real = twin.envs.runner.run_many
 
     def flaky(scenarios, **kwargs):
         if any(s.seed == seed for s in scenarios):
             raise error
         return real(scenarios, **kwargs)
 
-    monkeypatch.setattr(twin.runner, "run_many", flaky)
+    monkeypatch.setattr(twin.envs.runner, "run_many", flaky)
 
 
 def test_rerun_retries_what_failed(tmp_path, monkeypatch):
@@ -173,37 +174,37 @@ def test_a_store_without_a_version_but_with_results_is_refused(tmp_path):
 
 
 def test_a_killed_worker_is_one_clear_error_and_keeps_what_finished(tmp_path, monkeypatch):
-    import twin.runner
+    import twin.envs.runner
 
     parent = os.getpid()
-    real = twin.runner.run_many
+    real = twin.envs.runner.run_many
 
     def dies_in_worker(scenarios, **kwargs):
         if os.getpid() != parent and any(s.seed == 1 for s in scenarios):
             os.kill(os.getpid(), signal.SIGKILL)
         return real(scenarios, **kwargs)
 
-    monkeypatch.setattr(twin.runner, "run_many", dies_in_worker)
+    monkeypatch.setattr(twin.envs.runner, "run_many", dies_in_worker)
     points = grid.expand({"controller": ["ffpva"], "trajectory": [2], "seed": [0, 1]})
     with pytest.raises(WorkerLost, match="finished scenarios are kept.*run the same command again") as caught:
         run_sweep(points, out=tmp_path, workers=2)
     assert "\n" not in str(caught.value)
-    monkeypatch.setattr(twin.runner, "run_many", real)
+    monkeypatch.setattr(twin.envs.runner, "run_many", real)
     assert all(r["status"] == "ok" for r in run_sweep(points, out=tmp_path, workers=2).records)
 
 
 def test_a_scenario_that_raises_is_marked_failed_with_its_reason(monkeypatch):
-    import twin.runner
+    import twin.envs.runner
 
     points = grid.expand({"controller": ["ffpva"], "trajectory": [2], "seed": [0, 1, 2]})
-    real = twin.runner.run_many
+    real = twin.envs.runner.run_many
 
     def flaky(scenarios, **kwargs):
         if any(s.seed == 1 for s in scenarios):
             raise RuntimeError("boom on seed 1")
         return real(scenarios, **kwargs)
 
-    monkeypatch.setattr(twin.runner, "run_many", flaky)
+    monkeypatch.setattr(twin.envs.runner, "run_many", flaky)
     rows = run_chunk(points)
     assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
     assert "boom on seed 1" in rows[1]["reason"]

@@ -12,8 +12,8 @@ import math
 import numpy as np
 import pytest
 
-from twin.params import CylinderParams, ValveParams
-from twin.valves import ValveBank, ValveModel
+from twin.physics.params import CylinderParams, ValveParams
+from twin.physics.valves import ValveBank, ValveModel
 
 TICK = 1e-3  # s
 V1, V2, V3, V4 = range(4)  # supply A, drain A, supply B, drain B (§3)

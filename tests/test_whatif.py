@@ -16,10 +16,10 @@ import pytest
 import controllers
 from tests.conftest import open_loop
 from twin.cli import main
-from twin.gears import lewis_safe_load
-from twin.model import Orientation
-from twin.params import GearParams, JointParams
-from twin.whatif import lift_study, mesh_loads, pwm_study
+from twin.experiments.whatif import lift_study, mesh_loads, pwm_study
+from twin.physics.gears import lewis_safe_load
+from twin.physics.model import Orientation
+from twin.physics.params import GearParams, JointParams
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 COULOMB = (-3.051e14, 1.587e13, -3.244e11, 3.294e9, -1.727e7, 4.36e4, -39.551)  # eq. 4.5.7
@@ -149,10 +149,10 @@ def test_supply_variants_differ_in_the_supply_alone_and_sag_as_their_compliance_
     compliance at the valve block makes the same flow sag it less (the line's dip scales with sqrt(L / C))."""
     import dataclasses
 
+    from twin.envs.runner import run_many
+    from twin.experiments.whatif import SUPPLY_MODELS, supply_variants
     from twin.plants import plant
-    from twin.runner import run_many
-    from twin.scenario import Scenario
-    from twin.whatif import SUPPLY_MODELS, supply_variants
+    from twin.sim.scenario import Scenario
 
     base = plant("as-built")
     variants = supply_variants(base)

@@ -22,11 +22,11 @@ import signal
 import sys
 import time
 
-from twin.as_built import EFFECTS, as_built_plant
 from twin.exceptions import InvalidScenario, TwinError
-from twin.model import Orientation
+from twin.physics.model import Orientation
 from twin.plants import PLANTS, Plant
-from twin.scenario import CONTROLLER_NAMES, Scenario
+from twin.plants.as_built import EFFECTS, as_built_plant
+from twin.sim.scenario import CONTROLLER_NAMES, Scenario
 
 EXIT_USAGE = 2
 
@@ -119,8 +119,8 @@ def scenario_from(args: argparse.Namespace) -> Scenario:
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from twin import report
-    from twin.runner import run
+    from twin.envs.runner import run
+    from twin.sim import report
 
     result = run(scenario_from(args))
     if args.trace:
@@ -174,8 +174,8 @@ def _cmd_view(args: argparse.Namespace) -> int:
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
-    from twin import calibrate
-    from twin.as_built import CALIBRATION_FILE
+    from twin.experiments import calibrate
+    from twin.plants.as_built import CALIBRATION_FILE
     from viz.calibration_plots import plot_calibration
 
     args.out.mkdir(exist_ok=True)
@@ -201,13 +201,13 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from twin.demo import run_demo
+    from twin.experiments.demo import run_demo
 
     return run_demo(out=args.out, seeds=args.seeds, plots=args.plots)
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from twin.bench import measure
+    from twin.experiments.bench import measure
 
     for line in measure(batch_size=args.batch, workers=args.workers).lines():
         print(line)
@@ -226,8 +226,8 @@ def _out_dir(text: str) -> pathlib.Path:
 def _cmd_sweep(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from twin import grid, tables
-    from twin.sweep import open_store, run_sweep
+    from twin.batch import grid, tables
+    from twin.batch.sweep import open_store, run_sweep
 
     axes = grid.read_toml(args.config) if args.config else {}
     for name in grid.AXES:
@@ -271,7 +271,7 @@ _WHATIF_LISTS = {"payload": ("--payloads", "payloads", "payload"), "lift": ("--p
 def _whatif_values(args: argparse.Namespace, plant_name: str) -> list | None:
     """The study's list flag, parsed and every scenario it implies built (so bad input fails before
     anything is written), in edge units; errors name the flag. None for a study without a list."""
-    from twin import grid
+    from twin.batch import grid
     from twin.exceptions import InvalidScenario
 
     if args.study not in _WHATIF_LISTS:
@@ -289,7 +289,8 @@ def _whatif_values(args: argparse.Namespace, plant_name: str) -> list | None:
 def _cmd_whatif(args: argparse.Namespace) -> int:
     from tqdm import tqdm
 
-    from twin import tables, whatif
+    from twin.batch import tables
+    from twin.experiments import whatif
     from viz.whatif_plots import PLOTS
 
     plant_name = args.plant or whatif.DEFAULT_PLANTS[args.study]
@@ -323,8 +324,9 @@ def _cmd_whatif(args: argparse.Namespace) -> int:
 
 
 def _cmd_ablation(args: argparse.Namespace) -> int:
-    from twin import ablation, tables
-    from twin.as_built import calibrated_values
+    from twin.batch import tables
+    from twin.experiments import ablation
+    from twin.plants.as_built import calibrated_values
     from viz.study_plots import plot_ablation
 
     calibrated_values()  # no committed preset: a one-line error before anything is written
@@ -343,7 +345,7 @@ def _cmd_ablation(args: argparse.Namespace) -> int:
 
 
 def _cmd_study(args: argparse.Namespace) -> int:
-    from twin import studies
+    from twin.experiments import studies
     from twin.plants import plant
 
     plant_name = args.plant or studies.default_plant("thesis" if args.study == "robustness" else "thesis-pwm")
@@ -454,7 +456,7 @@ def build_parser() -> argparse.ArgumentParser:
     cal.add_argument("--workers", type=_positive_int, default=max(1, min(os.cpu_count() or 1, 4)),
                      help="processes (default: the cores, at most 4)")
     cal.add_argument("--max-evaluations", type=_positive_int, default=None, metavar="N",
-                     help="optimiser budget (default: twin.calibrate.MAX_EVALUATIONS)")
+                     help="optimiser budget (default: twin.experiments.calibrate.MAX_EVALUATIONS)")
     cal.add_argument("--install", action="store_true",
                      help="also make the result the as-built preset (twin/data/as_built.json)")
     cal.set_defaults(func=_cmd_calibrate)

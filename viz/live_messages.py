@@ -12,8 +12,8 @@ import dataclasses
 import json
 import math
 
-from twin.model import Orientation
-from twin.scenario import CONTROLLER_NAMES
+from twin.physics.model import Orientation
+from twin.sim.scenario import CONTROLLER_NAMES
 
 TARGET_RANGE_DEG = (0.0, 180.0)
 PAYLOAD_RANGE_G = (0.0, 50.0)

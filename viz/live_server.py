@@ -38,9 +38,9 @@ import umsgpack
 from meshcat.commands import Delete
 from meshcat.path import Path
 
+from twin.envs.live import LiveJoint, Readout
 from twin.exceptions import SimulationFailed, TwinError
-from twin.live import LiveJoint, Readout
-from twin.scenario import Scenario
+from twin.sim.scenario import Scenario
 from viz import live_messages
 from viz.recording import FPS, MESHCAT_SCRIPT, TraceRows, title_of, write_page
 from viz.scene import Frame, JointScene, frame_commands

@@ -11,7 +11,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
-from twin.simulation import Result  # noqa: E402
+from twin.sim.simulation import Result  # noqa: E402
 
 
 def title(result: Result) -> str:

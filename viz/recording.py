@@ -18,8 +18,8 @@ import numpy as np
 import umsgpack
 from meshcat.transformations import quaternion_from_matrix
 
-from twin.model import compile_joint
-from twin.simulation import Result
+from twin.physics.model import compile_joint
+from twin.sim.simulation import Result
 from viz.scene import Frame, JointScene
 
 FPS = 50  # animation frames per second of simulated time

@@ -31,8 +31,8 @@ import numpy as np
 from meshcat.commands import SetObject, SetProperty, SetTransform
 from meshcat.path import Path
 
-from twin.model import JointModel
-from twin.plant_state import place_on_manifold
+from twin.physics.model import JointModel
+from twin.sim.plant_state import place_on_manifold
 from viz.gear_mesh import gear_mesh, rack_mesh
 
 ROOT = "/twin"

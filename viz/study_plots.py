@@ -13,9 +13,9 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter  # noqa: E402
 
-from twin.demo import LABELS  # noqa: E402
+from twin.experiments.demo import LABELS  # noqa: E402
+from twin.experiments.studies import SOFT_LIMITS, OpenLoopStudy  # noqa: E402
 from twin.plants import plant  # noqa: E402
-from twin.studies import SOFT_LIMITS, OpenLoopStudy  # noqa: E402
 
 ORIENTATION_STYLES = {"horizontal": "-", "vertical": "--"}
 

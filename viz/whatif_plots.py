@@ -10,7 +10,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from twin.whatif import AVERAGING_WINDOWS, SUPPLY_MODELS, SUSTAINED_WINDOW, window_label  # noqa: E402
+from twin.experiments.whatif import AVERAGING_WINDOWS, SUPPLY_MODELS, SUSTAINED_WINDOW, window_label  # noqa: E402
 from viz.sweep_plots import plot_summary  # noqa: E402
 
 

@@ -1,0 +1,146 @@
+"""Sweep grids: axes named like the flags of ``twin run``, as comma lists or a TOML file.
+
+    --controller ffpva,smc --trajectory 1,3 --payload 0:13.5:6.75 --seed 0-4
+
+Numbers also take ``start:stop:step`` (stop included when it lands on the
+grid); seeds also ``a-b``. Units at this edge: grams, kPa, ms. One physical
+scenario is one grid point with one key: repeated values count once, and a
+supply pressure or PWM period equal to the plant's becomes None (the plant's).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import math
+import tomllib
+from collections.abc import Iterable
+
+from twin.exceptions import InvalidScenario
+from twin.physics.model import Orientation
+from twin.plants import plant
+from twin.sim.scenario import Scenario
+
+AXES = ("controller", "trajectory", "payload", "orientation", "plant", "seed", "supply_kpa", "pwm_period_ms")
+DEFAULTS = {"controller": ["ffpva"], "trajectory": [1], "payload": [0.0], "orientation": ["horizontal"],
+            "plant": ["thesis"], "seed": [0], "supply_kpa": [None], "pwm_period_ms": [None]}
+NUMERIC = {"payload": float, "supply_kpa": float, "pwm_period_ms": float, "trajectory": int, "seed": int}
+
+
+def _whole(value: float) -> int:
+    if not value.is_integer():
+        raise ValueError(f"{value!r} is not a whole number")
+    return int(value)
+
+
+def _number(text: str, kind: type) -> int | float:
+    """``kind`` from ``text``; an int axis takes ``"3"`` or ``"3.0"`` but refuses ``"2.7"`` (never truncates)."""
+    if kind is int:
+        try:
+            return int(text)
+        except ValueError:
+            return _whole(float(text))
+    return float(text) + 0.0  # + 0.0 turns -0.0 into 0.0: one value, one key
+
+
+def _range(text: str, kind: type) -> list:
+    parts = text.split(":")
+    if len(parts) != 3:
+        raise InvalidScenario(f"a range is start:stop:step, got {text!r}")
+    start, stop, step = (float(p) for p in parts)
+    if step <= 0 or stop < start:
+        raise InvalidScenario(f"a range needs step > 0 and stop >= start, got {text!r}")
+    count = int(math.floor((stop - start) / step + 1e-9)) + 1
+    values = [round(start + i * step, 12) + 0.0 for i in range(count)]
+    return [_whole(v) for v in values] if kind is int else values
+
+
+def parse_axis(name: str, value) -> list:
+    """One axis from a flag string (``"0,6.5,13.5"``, ``"0:30:5"``, ``"0-4"``) or a TOML list."""
+    if name not in AXES:
+        raise InvalidScenario(f"unknown sweep axis {name!r}: choose from {', '.join(AXES)}")
+    items: Iterable = value if isinstance(value, list) else str(value).split(",")
+    kind = NUMERIC.get(name, str)
+    out: list = []
+    for item in items:
+        text = str(item).strip()
+        try:
+            if kind is not str and ":" in text:
+                out += _range(text, kind)
+            elif name == "seed" and "-" in text.lstrip("-"):
+                low, high = (int(x) for x in text.split("-"))
+                out += list(range(low, high + 1))
+            else:
+                out.append(kind(text) if kind is str else _number(text, kind))
+        except ValueError:
+            expected = {int: ": expected whole numbers", float: ": expected numbers"}.get(kind, "")
+            raise InvalidScenario(f"bad value {text!r} for --{name.replace('_', '-')}{expected}") from None
+    if not out:
+        raise InvalidScenario(f"--{name.replace('_', '-')} is empty")
+    return list(dict.fromkeys(out))  # "0,0" is one value
+
+
+def read_toml(path) -> dict[str, list]:
+    """Axes from a TOML file: top-level keys or a ``[grid]`` table, named like the flags."""
+    try:
+        with open(path, "rb") as handle:
+            data = tomllib.load(handle)
+    except OSError as error:
+        raise InvalidScenario(f"cannot read --config {str(path)!r}: {error.strerror}") from None
+    except ValueError as error:  # TOMLDecodeError, or bytes that are not UTF-8
+        raise InvalidScenario(f"--config {str(path)!r} is not valid TOML: {error}") from None
+    table = data.get("grid", data)
+    if not isinstance(table, dict):
+        raise InvalidScenario(f"--config {str(path)!r}: [grid] must be a table of axes")
+    return {key.replace("-", "_"): parse_axis(key.replace("-", "_"), value) for key, value in table.items()}
+
+
+@dataclasses.dataclass(frozen=True)
+class GridPoint:
+    """One scenario of a sweep, in edge units, with a stable key."""
+
+    controller: str
+    trajectory: int
+    payload_g: float
+    orientation: str
+    plant: str
+    seed: int
+    supply_kpa: float | None
+    pwm_period_ms: float | None
+
+    @property
+    def key(self) -> str:
+        return "|".join(str(v) for v in dataclasses.astuple(self))
+
+    def scenario(self) -> Scenario:
+        return Scenario(controller=self.controller, trajectory=self.trajectory, payload=self.payload_g / 1e3,
+                        orientation=_orientation(self.orientation), plant=self.plant, seed=self.seed,
+                        supply_pressure=None if self.supply_kpa is None else self.supply_kpa * 1e3,
+                        pwm_period=None if self.pwm_period_ms is None else self.pwm_period_ms / 1e3)
+
+
+def _orientation(text: str) -> Orientation:
+    try:
+        return Orientation(text)
+    except ValueError:
+        choices = ", ".join(o.value for o in Orientation)
+        raise InvalidScenario(f"unknown orientation {text!r}: choose one of {choices}") from None
+
+
+def _without_plant_defaults(point: GridPoint) -> GridPoint:
+    """``point`` with a supply pressure or PWM period equal to its plant's set to None (the plant's), so
+    that a scenario has one key whether or not its plant's value was given explicitly."""
+    params = plant(point.plant).params
+    scenario = point.scenario()
+    return dataclasses.replace(
+        point,
+        supply_kpa=None if scenario.supply_pressure == params.supply.pressure else point.supply_kpa,
+        pwm_period_ms=None if scenario.pwm_period == params.valves.pwm_period else point.pwm_period_ms,
+    )
+
+
+def expand(axes: dict[str, list]) -> list[GridPoint]:
+    """Every distinct combination, in a fixed order; each checked by building its Scenario."""
+    merged = {**DEFAULTS, **axes}
+    points = (GridPoint(*combo) for combo in itertools.product(*(merged[a] for a in AXES)))
+    return list(dict.fromkeys(_without_plant_defaults(p) for p in points))  # scenario() names a bad value

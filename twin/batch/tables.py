@@ -1,0 +1,83 @@
+"""Sweep tables: per-scenario rows to CSV and Parquet, and a summary grouped
+like the thesis's tables (mean, std and range over seeds)."""
+
+from __future__ import annotations
+
+import csv
+import math
+import pathlib
+from collections.abc import Sequence
+
+import numpy as np
+
+from twin.batch.store import COLUMNS
+
+GROUP_BY = ("controller", "trajectory", "payload_g", "orientation", "plant", "supply_kpa", "pwm_period_ms")
+SUMMARY_COLUMNS = GROUP_BY + ("runs", "failed", "rmse_mean_deg", "rmse_std_deg", "rmse_min_deg", "rmse_max_deg",
+                              "sse_mean_deg", "sse_min_deg", "sse_max_deg", "max_error_deg")
+
+
+def sample_std(values: Sequence[float]) -> float:
+    """The std of runs as the thesis's tables give it (ddof 1); 0 for a single run."""
+    return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
+
+
+def write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
+    """``rows`` as CSV with ``columns`` (lists joined with ';', None empty), written whole or not at all."""
+    tmp = path.with_suffix(path.suffix + ".tmp")
+    with open(tmp, "w", newline="") as handle:
+        writer = csv.DictWriter(handle, fieldnames=list(columns), extrasaction="ignore")
+        writer.writeheader()
+        for row in rows:
+            writer.writerow({c: (";".join(row[c]) if isinstance(row[c], list | tuple) else row[c]) for c in columns})
+    tmp.replace(path)  # never a half-written file
+
+
+def write_results(rows: Sequence[dict], out: pathlib.Path) -> None:
+    """``results.csv`` and ``results.parquet``, one row per scenario."""
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    write_csv(rows, COLUMNS, out / "results.csv")
+    table = pa.table({c: [(";".join(r[c]) if c == "warnings" else r[c]) for r in rows] for c in COLUMNS})
+    pq.write_table(table, out / "results.parquet.tmp")
+    (out / "results.parquet.tmp").replace(out / "results.parquet")
+
+
+def summarise(rows: Sequence[dict]) -> list[dict]:
+    groups: dict[tuple, list[dict]] = {}
+    for row in rows:
+        groups.setdefault(tuple(row[c] for c in GROUP_BY), []).append(row)
+    summary = []
+    for key, members in groups.items():
+        ok = [r for r in members if r["status"] == "ok"]
+        rmse = np.array([r["rmse_deg"] for r in ok]) if ok else np.array([math.nan])
+        sse = np.array([math.nan if r["sse_deg"] is None else r["sse_deg"] for r in ok]) if ok else np.array([math.nan])
+        summary.append({
+            **dict(zip(GROUP_BY, key, strict=True)), "runs": len(members), "failed": len(members) - len(ok),
+            "rmse_mean_deg": float(np.mean(rmse)), "rmse_std_deg": sample_std(rmse),
+            "rmse_min_deg": float(np.min(rmse)), "rmse_max_deg": float(np.max(rmse)),
+            "sse_mean_deg": float(np.mean(sse)), "sse_min_deg": float(np.min(sse)), "sse_max_deg": float(np.max(sse)),
+            "max_error_deg": float(max((r["max_error_deg"] for r in ok), default=math.nan)),
+        })
+    return summary
+
+
+def write_summary(summary: Sequence[dict], out: pathlib.Path) -> None:
+    write_csv(summary, SUMMARY_COLUMNS, out / "summary.csv")
+
+
+def format_summary(summary: Sequence[dict], limit: int = 40) -> str:
+    lines = [f"{'controller':10} {'T':>2} {'payload g':>9} {'orient':>10} {'plant':>8} {'kPa':>5} {'PWM ms':>6} "
+             f"{'runs':>4} {'fail':>4} {'RMSE mean±std':>14} {'SSE range':>16}"]
+    for s in summary[:limit]:
+        sse_range = ("   - (ends moving)" if math.isnan(s["sse_min_deg"])
+                     else f"[{s['sse_min_deg']:+6.2f},{s['sse_max_deg']:+6.2f}]")
+        lines.append(
+            f"{s['controller']:10} {s['trajectory']:>2} {s['payload_g']:>9g} {s['orientation']:>10} {s['plant']:>8} "
+            f"{'-' if s['supply_kpa'] is None else format(s['supply_kpa'], 'g'):>5} "
+            f"{'-' if s['pwm_period_ms'] is None else format(s['pwm_period_ms'], 'g'):>6} {s['runs']:>4} {s['failed']:>4} "
+            f"{s['rmse_mean_deg']:>7.2f}±{s['rmse_std_deg']:<6.2f} {sse_range}")
+    if len(summary) > limit:
+        lines.append(f"... {len(summary) - limit} more groups in summary.csv")
+    return "\n".join(lines)

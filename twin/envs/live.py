@@ -1,0 +1,162 @@
+"""One scenario stepped on demand, with its target changed while it runs
+(``twin view``).
+
+The step order is :func:`twin.sim.simulation.simulate`'s: sensors, controller (at
+its period), valves and hydraulics (:class:`twin.sim.plant_state.PlantState`),
+physics. Only the reference differs: instead of a fixed trajectory it is a
+*plan* that the user replaces while the joint moves:
+
+* a target angle: a cycloidal move (eq. 5.2.5) from the current desired angle,
+  at most ``MOVE_RATE`` fast and no shorter than ``MIN_MOVE``, then a hold;
+* a trajectory T1-T4: a cycloidal move to its start angle, a short rest, then
+  the trajectory as §7 defines it, then a hold at its end.
+
+Sensor noise is drawn in blocks of ``NOISE_BLOCK`` ticks from the scenario's
+seed and the block number, so a live run can last as long as the user likes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import mujoco
+import numpy as np
+
+from twin.envs.runner import thesis_controllers
+from twin.physics.model import compile_joint
+from twin.physics.sensing import uniform_noise
+from twin.physics.ticks import whole_ticks
+from twin.physics.trajectories import Segment, Trajectory, trajectory
+from twin.sim.control import Setpoint
+from twin.sim.plant_state import PlantState, place_on_manifold, true_start
+from twin.sim.scenario import Scenario
+
+MOVE_RATE = math.radians(120.0)  # rad/s, average speed of a target move: T1's 120 deg in 1 s
+MIN_MOVE = 0.3  # s
+REST_BEFORE_TRAJECTORY = 0.3  # s
+NOISE_BLOCK = 60_000  # ticks; a multiple of every PWM and controller period in ticks
+
+
+@dataclasses.dataclass(frozen=True)
+class Readout:
+    time: float  # s since the start of this model
+    angle: float  # rad, true output angle
+    desired_angle: float  # rad
+    duty: float  # %, command in force
+    pressure_a: float  # Pa, measured
+    pressure_b: float  # Pa, measured
+    supply_pressure: float  # Pa, measured
+    valve_open: tuple[bool, bool, bool, bool]  # V1..V4
+
+    @property
+    def error(self) -> float:
+        return self.desired_angle - self.angle  # rad
+
+
+class LiveJoint:
+    """``scenario`` (its trajectory is the first plan), ready to :meth:`advance`."""
+
+    def __init__(self, scenario: Scenario):
+        preset = scenario.preset
+        self.scenario = scenario
+        self.joint = compile_joint(params=preset.params, payload_mass=scenario.payload,
+                                   orientation=scenario.orientation, timestep=preset.timestep)
+        self.model = self.joint.model
+        self.data = mujoco.MjData(self.model)
+        self.tick = preset.timestep
+        self.spur_radius = preset.params.gears.spur_radius
+        self.switch_controller(scenario.controller)
+
+        first = trajectory(scenario.trajectory, spur_radius=self.spur_radius)
+        self.plan, self.plan_start = first, 0.0
+        y0 = true_start([scenario], np.array([first.start * self.spur_radius]))  # the sensor reads the start
+        qpos = self.data.qpos[None, :].copy()
+        place_on_manifold(qpos, self.joint, y0)
+        self.data.qpos[:] = qpos[0]
+        mujoco.mj_forward(self.model, self.data)
+        self.plant = PlantState(scenarios=[scenario], joints=[self.joint], lengths=[NOISE_BLOCK],
+                                initial_position=y0, tick=self.tick)
+        self.block, self.k, self.steps = 0, 0, 0
+        self.duty = np.zeros(1)
+        self.dof = self.joint.rack_a_dof
+
+    def switch_controller(self, name: str) -> None:
+        """Drive the joint with controller ``name`` from the next tick on (a fresh controller state)."""
+        self.scenario = dataclasses.replace(self.scenario, controller=name)
+        self.controller = thesis_controllers([self.scenario])[0]
+        self.controller.reset(1)
+        self.every = whole_ticks(self.controller.period, self.tick, what="controller period")
+        pwm = whole_ticks(self.scenario.preset.params.valves.pwm_period, self.tick)
+        if NOISE_BLOCK % self.every or NOISE_BLOCK % pwm:
+            raise ValueError("NOISE_BLOCK must be a whole number of controller and PWM periods")
+
+    @property
+    def time(self) -> float:
+        return self.steps * self.tick  # s
+
+    def desired(self, at: float | None = None) -> tuple[float, float, float]:
+        """The plan's desired rack position (m), velocity and acceleration at time ``at``."""
+        t = self.time if at is None else at
+        ref = self.plan.sample(np.array([t - self.plan_start]), self.spur_radius)
+        return float(ref.position[0]), float(ref.velocity[0]), float(ref.acceleration[0])
+
+    def set_target(self, angle: float) -> None:
+        """Move to ``angle`` (rad) and hold there."""
+        start = self.desired()[0] / self.spur_radius
+        move = max(MIN_MOVE, abs(angle - start) / MOVE_RATE)
+        self._replan(Trajectory(0, start, (Segment("cycloid", move, angle - start),)))
+
+    def play(self, number: int) -> None:
+        """Go to trajectory ``number``'s start, then run it."""
+        chosen = trajectory(number, spur_radius=self.spur_radius)
+        start = self.desired()[0] / self.spur_radius
+        move = max(MIN_MOVE, abs(chosen.start - start) / MOVE_RATE)
+        lead = (Segment("cycloid", move, chosen.start - start), Segment("rest", REST_BEFORE_TRAJECTORY))
+        self._replan(Trajectory(number, start, lead + chosen.segments))
+
+    def _replan(self, plan: Trajectory) -> None:
+        self.plan, self.plan_start = plan, self.time
+
+    def _next_noise_block(self) -> None:
+        self.block += 1
+        rng = np.random.default_rng([self.scenario.seed, self.block])
+        sensors = self.scenario.preset.params.sensors
+        if self.scenario.noise:
+            self.plant.position_noise[0] = uniform_noise(rng, sensors.position_noise, (NOISE_BLOCK,))
+            self.plant.pressure_noise[0] = uniform_noise(rng, sensors.pressure_noise, (NOISE_BLOCK, 3))
+        self.k = 0
+
+    def step(self) -> None:
+        """One tick, in :func:`twin.sim.simulation.simulate`'s order."""
+        if self.k == NOISE_BLOCK:
+            self._next_noise_block()
+        d = self.data
+        y, v = d.qpos[self.dof:self.dof + 1].copy(), d.qvel[self.dof:self.dof + 1].copy()
+        measurement = self.plant.sense(self.k, y)
+        if self.k % self.every == 0:
+            position, velocity, acceleration = self.desired()
+            setpoint = Setpoint(position=np.array([position]), velocity=np.array([velocity]),
+                                acceleration=np.array([acceleration]))
+            self.duty = self.controller.update(self.time, measurement, setpoint)
+        external = self.plant.external_force(d.qfrc_passive[None, :], d.qfrc_bias[None, :])
+        force_a, force_b = self.plant.actuate(self.k, self.duty, y, v, external)
+        d.ctrl[:] = (force_a[0], force_b[0])
+        mujoco.mj_step2(self.model, d)  # then mj_step1: derived fields (gravity) at the new state
+        mujoco.mj_step1(self.model, d)
+        self.k += 1
+        self.steps += 1
+
+    def advance(self, duration: float) -> None:
+        """Step ``duration`` seconds (whole ticks, rounded down)."""
+        for _ in range(int(duration / self.tick + 1e-9)):
+            self.step()
+
+    def readout(self) -> Readout:
+        pa, pb = self.plant.measured_pressures(min(self.k, NOISE_BLOCK - 1))
+        return Readout(
+            time=self.time, angle=float(self.data.qpos[self.joint.spur_dof]),
+            desired_angle=self.desired()[0] / self.spur_radius, duty=float(self.duty[0]),
+            pressure_a=float(pa[0]), pressure_b=float(pb[0]),
+            supply_pressure=float(self.plant.supply_now[0]),
+            valve_open=tuple(bool(x) for x in self.plant.conductance[0] > 0))

@@ -1,0 +1,133 @@
+"""``twin demo``: the thesis's simulated controller comparison, reproduced.
+
+Runs PVA + DZC, FF + PVA and sliding mode on T1 - T4 on the ``thesis`` plant,
+over several noise seeds, in one batch; prints RMSE, SSE and max error (mean
+and std over seeds) beside the thesis's simulated values (SPEC §8), and writes
+into the output folder: ``results.csv`` (one row per run), ``summary.md`` (the
+table) and one PNG per run.
+"""
+
+from __future__ import annotations
+
+import csv
+import pathlib
+import sys
+
+import numpy as np
+from tqdm import tqdm
+
+from twin.batch.tables import sample_std
+from twin.envs.runner import run_many
+from twin.experiments.reference import (
+    THESIS_SIMULATED_RMSE_DEG,
+    THESIS_SIMULATED_SSE_T1_DEG,
+    THESIS_SIMULATED_T4_REST_ERRORS_DEG,
+)
+from twin.sim import report
+from twin.sim.scenario import CONTROLLER_NAMES, TRAJECTORY_NUMBERS, Scenario
+from twin.sim.simulation import Result
+
+LABELS = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
+
+
+def demo_scenarios(seeds: int) -> list[Scenario]:
+    return [Scenario(controller=c, trajectory=t, plant="thesis", seed=s)
+            for c in CONTROLLER_NAMES for t in TRAJECTORY_NUMBERS for s in range(seeds)]
+
+
+def summary_rows(results: list[Result]) -> list[dict]:
+    """One row per controller x trajectory: mean and std over seeds, thesis value beside."""
+    rows = []
+    for c in CONTROLLER_NAMES:
+        for t in TRAJECTORY_NUMBERS:
+            records = [report.summary(r) for r in results
+                       if r.scenario.controller == c and r.scenario.trajectory == t]
+            rmse = np.array([r["rmse_deg"] for r in records])
+            sse = np.array([np.nan if r["sse_deg"] is None else r["sse_deg"] for r in records])
+            peak = np.array([r["max_error_deg"] for r in records])
+            thesis = THESIS_SIMULATED_RMSE_DEG.get(c, {}).get(t)
+            rows.append({
+                "controller": c, "trajectory": t, "runs": len(records),
+                "rmse_mean": rmse.mean(), "rmse_std": sample_std(rmse),
+                "sse_mean": sse.mean(), "sse_min": sse.min(), "sse_max": sse.max(),
+                "max_error_mean": peak.mean(), "thesis_rmse": thesis,
+                "thesis_sse": THESIS_SIMULATED_SSE_T1_DEG.get(c) if t == 1 else None,
+                "warnings": sum(len(r["warnings"]) for r in records),
+            })
+    return rows
+
+
+def _fmt(value, spec: str = ".2f") -> str:
+    return "–" if value is None else format(value, spec)
+
+
+def _sse(row: dict) -> str:
+    if np.isnan(row["sse_mean"]):
+        return "– (ends moving)"
+    return f"{row['sse_mean']:+.2f} [{row['sse_min']:+.2f}, {row['sse_max']:+.2f}]"
+
+
+def rest_error_table(results: list[Result]) -> str:
+    """T4's errors at the end of its four rests, seed mean, beside the thesis's simulated ones."""
+    lines = ["| controller | T4 rest errors (deg), twin mean over seeds | thesis sim |", "|---|---|---|"]
+    for c in CONTROLLER_NAMES:
+        runs = [r for r in results if r.scenario.controller == c and r.scenario.trajectory == 4]
+        if not runs:
+            continue
+        mean = np.degrees(np.mean([r.metrics.rest_errors for r in runs], axis=0))
+        thesis = THESIS_SIMULATED_T4_REST_ERRORS_DEG.get(c)
+        lines.append(f"| {LABELS[c]} | {', '.join(f'{e:+.2f}' for e in mean)} | "
+                     f"{', '.join(f'{e:+.2f}' for e in thesis) if thesis else '–'} |")
+    return "\n".join(lines)
+
+
+def markdown_table(rows: list[dict]) -> str:
+    lines = ["| controller | traj | RMSE (deg) mean ± std | thesis sim RMSE | diff | SSE mean [min, max] | thesis SSE | max \\|e\\| mean |",
+             "|---|---|---|---|---|---|---|---|"]
+    for r in rows:
+        diff = None if r["thesis_rmse"] is None else r["rmse_mean"] - r["thesis_rmse"]
+        lines.append(
+            f"| {LABELS[r['controller']]} | T{r['trajectory']} | {r['rmse_mean']:.2f} ± {r['rmse_std']:.2f} | "
+            f"{_fmt(r['thesis_rmse'])} | {_fmt(diff, '+.2f')} | {_sse(r)} | "
+            f"{_fmt(r['thesis_sse'])} | {r['max_error_mean']:.2f} |")
+    return "\n".join(lines)
+
+
+def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
+    out.mkdir(parents=True, exist_ok=True)
+    scenarios = demo_scenarios(seeds)
+    print(f"Simulating {len(scenarios)} runs on the 'thesis' plant; output in {out.resolve()}", file=sys.stderr)
+    with tqdm(total=1, desc="simulating", unit="tick", file=sys.stderr, dynamic_ncols=True) as bar:
+        def progress(done: int, total: int) -> None:
+            bar.total = total
+            bar.n = done
+            bar.refresh()
+
+        results = run_many(scenarios, progress=progress)
+
+    with open(out / "results.csv", "w", newline="") as handle:
+        writer = None
+        for result in results:
+            record = report.summary(result)
+            record["warnings"] = ";".join(record["warnings"])
+            record["rest_errors_deg"] = ";".join(f"{e:.4f}" for e in record["rest_errors_deg"])
+            if writer is None:
+                writer = csv.DictWriter(handle, fieldnames=list(record))
+                writer.writeheader()
+            writer.writerow(record)
+    rows = summary_rows(results)
+    table = markdown_table(rows) + "\n\n" + rest_error_table(results)
+    (out / "summary.md").write_text(
+        f"# Thesis controller comparison on the twin ('thesis' plant, {seeds} seeds)\n\n{table}\n")
+    if plots:
+        from viz.plots import plot_run
+
+        for result in tqdm(results, desc="plotting", unit="png", file=sys.stderr, dynamic_ncols=True):
+            s = result.scenario
+            plot_run(result, out / f"{s.controller}_T{s.trajectory}_seed{s.seed}.png")
+    print(table)
+    failed = [r for r in results if r.warnings]
+    for r in failed:
+        print(f"warning: {r.scenario}: {', '.join(r.warnings)}", file=sys.stderr)
+    print(f"\nWrote {out / 'results.csv'}, {out / 'summary.md'}" + (f" and {len(results)} PNGs" if plots else ""))
+    return 1 if failed else 0

@@ -1,0 +1,75 @@
+"""One run of the joint: what to simulate, checked on construction."""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import numbers
+
+from twin.exceptions import InvalidScenario
+from twin.physics.model import MAX_PAYLOAD, Orientation
+from twin.plants import Plant, plant
+
+CONTROLLER_NAMES = ("pva", "ffpva", "smc")
+TRAJECTORY_NUMBERS = (1, 2, 3, 4)
+
+
+@dataclasses.dataclass(frozen=True)
+class Scenario:
+    controller: str  # "pva", "ffpva" or "smc"
+    trajectory: int  # 1..4
+    payload: float = 0.0  # kg at the link tip
+    orientation: Orientation = Orientation.HORIZONTAL
+    plant: str | Plant = "thesis"  # a preset name, or a Plant for what-ifs and tests
+    seed: int = 0
+    noise: bool = True  # the thesis's sensor noise (§5)
+    supply_pressure: float | None = None  # Pa gauge; None: the plant's
+    pwm_period: float | None = None  # s; None: the plant's (16 ms); a whole number of ticks
+
+    def __post_init__(self) -> None:
+        if self.controller not in CONTROLLER_NAMES:
+            raise InvalidScenario(f"unknown controller {self.controller!r}: choose one of {', '.join(CONTROLLER_NAMES)}")
+        if self.trajectory not in TRAJECTORY_NUMBERS:
+            raise InvalidScenario(f"unknown trajectory {self.trajectory!r}: choose 1, 2, 3 or 4")
+        if not isinstance(self.payload, numbers.Real) or not math.isfinite(self.payload) \
+                or not 0 <= self.payload <= MAX_PAYLOAD:
+            shown = f"{self.payload * 1e3:g} g" if isinstance(self.payload, numbers.Real) else repr(self.payload)
+            raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, got {shown}")
+        if not isinstance(self.orientation, Orientation):
+            raise InvalidScenario(f"orientation must be an Orientation, got {self.orientation!r}")
+        if self.pwm_period is not None:
+            base = self.plant if isinstance(self.plant, Plant) else plant(self.plant)
+            ticks = self.pwm_period / base.timestep
+            if not math.isfinite(self.pwm_period) or self.pwm_period <= 0 or abs(ticks - round(ticks)) > 1e-9 \
+                    or not 4 <= round(ticks) <= 100:
+                raise InvalidScenario(f"PWM period must be a whole number of {base.timestep * 1e3:g} ms ticks "
+                                      f"between 4 and 100 ticks, got {self.pwm_period * 1e3:g} ms")
+        preset = self.preset
+        if not isinstance(self.seed, numbers.Integral) or isinstance(self.seed, bool) or self.seed < 0:
+            raise InvalidScenario(f"seed must be a non-negative integer, got {self.seed!r}")
+        if self.supply_pressure is not None:
+            rated = preset.params.cylinder.rated_pressure
+            if not math.isfinite(self.supply_pressure) or not 0 < self.supply_pressure <= rated:
+                raise InvalidScenario(
+                    f"supply pressure must be in (0, {rated / 1e3:g}] kPa (cylinder rating), "
+                    f"got {self.supply_pressure / 1e3:g} kPa")
+
+    @property
+    def preset(self) -> Plant:
+        """The plant this scenario runs, with its PWM period applied."""
+        base = self.plant if isinstance(self.plant, Plant) else plant(self.plant)
+        if self.pwm_period is None or self.pwm_period == base.params.valves.pwm_period:
+            return base
+        valves = dataclasses.replace(base.params.valves, pwm_period=self.pwm_period)
+        return dataclasses.replace(base, params=dataclasses.replace(base.params, valves=valves))
+
+    @property
+    def plant_name(self) -> str:
+        return self.preset.name
+
+    @property
+    def supply(self) -> float:
+        """Supply pressure in Pa."""
+        if self.supply_pressure is not None:
+            return self.supply_pressure
+        return self.preset.params.supply.pressure
