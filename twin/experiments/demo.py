@@ -24,10 +24,8 @@ from twin.experiments.reference import (
     THESIS_SIMULATED_T4_REST_ERRORS_DEG,
 )
 from twin.sim import report
-from twin.sim.scenario import CONTROLLER_NAMES, TRAJECTORY_NUMBERS, Scenario
+from twin.sim.scenario import CONTROLLER_LABELS, CONTROLLER_NAMES, TRAJECTORY_NUMBERS, Scenario
 from twin.sim.simulation import Result
-
-LABELS = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
 
 
 def demo_scenarios(seeds: int) -> list[Scenario]:
@@ -76,7 +74,7 @@ def rest_error_table(results: list[Result]) -> str:
             continue
         mean = np.degrees(np.mean([r.metrics.rest_errors for r in runs], axis=0))
         thesis = THESIS_SIMULATED_T4_REST_ERRORS_DEG.get(c)
-        lines.append(f"| {LABELS[c]} | {', '.join(f'{e:+.2f}' for e in mean)} | "
+        lines.append(f"| {CONTROLLER_LABELS[c]} | {', '.join(f'{e:+.2f}' for e in mean)} | "
                      f"{', '.join(f'{e:+.2f}' for e in thesis) if thesis else '–'} |")
     return "\n".join(lines)
 
@@ -87,7 +85,7 @@ def markdown_table(rows: list[dict]) -> str:
     for r in rows:
         diff = None if r["thesis_rmse"] is None else r["rmse_mean"] - r["thesis_rmse"]
         lines.append(
-            f"| {LABELS[r['controller']]} | T{r['trajectory']} | {r['rmse_mean']:.2f} ± {r['rmse_std']:.2f} | "
+            f"| {CONTROLLER_LABELS[r['controller']]} | T{r['trajectory']} | {r['rmse_mean']:.2f} ± {r['rmse_std']:.2f} | "
             f"{_fmt(r['thesis_rmse'])} | {_fmt(diff, '+.2f')} | {_sse(r)} | "
             f"{_fmt(r['thesis_sse'])} | {r['max_error_mean']:.2f} |")
     return "\n".join(lines)

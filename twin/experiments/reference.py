@@ -18,3 +18,6 @@ THESIS_EXPERIMENT_RMSE_DEG = {
 }
 # Experiment T1 steady-state error range (+-, deg) over the 5 runs (§8).
 THESIS_EXPERIMENT_SSE_T1_RANGE_DEG = {"pva": 0.41, "ffpva": 0.77, "smc": 0.85}
+
+# The robustness study's tip payloads (§9), g.
+THESIS_PAYLOADS_G = (0.0, 6.5, 13.5)

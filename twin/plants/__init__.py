@@ -26,51 +26,67 @@ controllers use on it.
 
 from __future__ import annotations
 
-import dataclasses
+from collections.abc import Callable, Iterator, MutableMapping
 
-from twin.exceptions import InvalidScenario
-from twin.physics.params import FrictionParams, JointParams, ValveParams
-from twin.physics.valves import ValveModel
-
-
-@dataclasses.dataclass(frozen=True)
-class Plant:
-    name: str
-    params: JointParams
-    valve_model: ValveModel
-    gain_set: str  # "simulation" or "experiment"
-    timestep: float = 1e-3  # s, physics step = sensor tick
-    metrics_on_sensor: bool = False  # score the Hall reading (as the thesis's experiments did), not the true angle
+from twin.exceptions import InvalidScenario, TwinError
+from twin.plants import as_built
+from twin.plants.preset import THESIS_PARAMS, THESIS_PLANTS, Plant
 
 
-THESIS_PARAMS = JointParams(
-    valves=ValveParams(dead_zone_duty=0.0),
-    friction=FrictionParams(stiction=0.0),
-)
+class PlantRegistry(MutableMapping):
+    """Name -> :class:`Plant`. The ``thesis*`` presets are plain values; ``as-built`` is read from its
+    calibration file on first use, so importing the twin (or running a ``thesis`` plant) never reads
+    it. ``as-built`` is listed while its file exists; a file that cannot be read is a one-line
+    :class:`InvalidScenario` when the preset is asked for (``twin calibrate --install`` remakes it)."""
 
-PLANTS = {
-    "thesis": Plant("thesis", THESIS_PARAMS, ValveModel.AVERAGED, "simulation"),
-    "thesis-deadzone": Plant("thesis-deadzone", dataclasses.replace(THESIS_PARAMS, valves=ValveParams()),
-                             ValveModel.AVERAGED, "simulation"),
-    "thesis-continuous": Plant("thesis-continuous", dataclasses.replace(
-        THESIS_PARAMS, valves=ValveParams(dead_zone_duty=0.0, switching_period=0.0)), ValveModel.AVERAGED, "simulation"),
-    "thesis-pwm": Plant("thesis-pwm", dataclasses.replace(THESIS_PARAMS, valves=ValveParams()),
-                        ValveModel.PWM, "simulation"),
-}
+    def __init__(self, plants: dict[str, Plant], lazy: dict[str, tuple[Callable[[], bool], Callable[[], Plant]]]):
+        self._plants = dict(plants)
+        self._lazy = dict(lazy)  # name -> (is it there, build it)
+
+    def __getitem__(self, name: str) -> Plant:
+        if name not in self._plants:
+            if name not in self._lazy or not self._lazy[name][0]():
+                raise KeyError(name)
+            try:
+                self._plants[name] = self._lazy[name][1]()
+            except TwinError as error:
+                raise InvalidScenario(f"no {name} plant: {error}") from None
+        return self._plants[name]
+
+    def __iter__(self) -> Iterator[str]:
+        yield from self._plants
+        yield from (name for name, (present, _) in self._lazy.items() if name not in self._plants and present())
+
+    def __len__(self) -> int:
+        return sum(1 for _ in self)
+
+    def __setitem__(self, name: str, preset: Plant) -> None:
+        self._plants[name] = preset
+
+    def __delitem__(self, name: str) -> None:
+        if name not in self:
+            raise KeyError(name)
+        self._plants.pop(name, None)
+        self._lazy.pop(name, None)
+
+    def __repr__(self) -> str:
+        """As a dict of the presets that load (a broken calibration file drops ``as-built``)."""
+        loaded = {}
+        for name in self:
+            try:
+                loaded[name] = self[name]
+            except InvalidScenario:
+                pass
+        return repr(loaded)
 
 
-from twin.exceptions import TwinError  # noqa: E402
-from twin.plants.as_built import as_built_plant  # noqa: E402  (it builds on Plant)
-
-try:  # a missing or broken calibration file loses the preset, not the package (twin calibrate remakes it)
-    PLANTS["as-built"] = as_built_plant()
-except TwinError as error:
-    import warnings
-
-    warnings.warn(f"no as-built plant: {error}", stacklevel=1)
+PLANTS = PlantRegistry(THESIS_PLANTS, {"as-built": (as_built.CALIBRATION_FILE.exists, as_built.as_built_plant)})
 
 
 def plant(name: str) -> Plant:
     if name not in PLANTS:
         raise InvalidScenario(f"unknown plant {name!r}: choose one of {', '.join(PLANTS)}")
     return PLANTS[name]
+
+
+__all__ = ["PLANTS", "THESIS_PARAMS", "Plant", "PlantRegistry", "plant"]

@@ -31,7 +31,7 @@ period, which the measured R(d) says the real joint does not).
 
 The parameters the thesis does not give are :data:`FITTED`, with the bounds that
 keep them physically plausible; ``twin calibrate`` fits them to §8's experimental
-table and writes ``twin/data/as_built.json``, which this module reads. Other
+table and writes ``twin/plants/data/as_built.json``, which this module reads. Other
 as-built values are assumptions, stated in :data:`ASSUMED`.
 """
 
@@ -45,6 +45,7 @@ from collections.abc import Iterable
 from twin.exceptions import InvalidScenario
 from twin.physics.params import ChamberParams, HallParams, JointParams, StictionMapParams, SupplyLineParams
 from twin.physics.valves import ValveModel
+from twin.plants.preset import THESIS_PARAMS, Plant
 
 EFFECTS = ("compressibility", "supply_line", "stiction", "ccw_friction", "dead_zone", "held_supply",
            "hall_calibration", "experiment_gains", "sensor_metrics")
@@ -111,7 +112,7 @@ def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) ->
     if "supply_line" in on and "compressibility" not in on:
         raise InvalidScenario("the supply line is integrated with the compressible chambers: switch "
                               "compressibility on with it, or switch supply_line off too")
-    from twin.plants import THESIS_PARAMS as base  # twin.plants registers this plant: import late
+    base = THESIS_PARAMS
     friction = dataclasses.replace(
         base.friction,
         stiction=values["stiction"] if "stiction" in on else base.friction.stiction,
@@ -136,7 +137,6 @@ def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) ->
 def as_built_plant(values: dict[str, float] | None = None, *, without: Iterable[str] = (),
                    name: str = "as-built"):
     """The as-built :class:`twin.plants.Plant` (the committed calibration unless ``values`` are given)."""
-    from twin.plants import Plant
     params, options = as_built_params(calibrated_values() if values is None else values, without=without)
     return Plant(name, params, ValveModel.AVERAGED, options["gain_set"],
                  metrics_on_sensor=options["metrics_on_sensor"])

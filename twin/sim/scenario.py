@@ -11,6 +11,8 @@ from twin.physics.model import MAX_PAYLOAD, Orientation
 from twin.plants import Plant, plant
 
 CONTROLLER_NAMES = ("pva", "ffpva", "smc")
+CONTROLLER_LABELS = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}  # for tables and plots
+MODEL_BASED_CONTROLLERS = ("ffpva", "smc")  # the two with the feed-forward model (§6)
 TRAJECTORY_NUMBERS = (1, 2, 3, 4)
 
 

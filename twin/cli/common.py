@@ -1,0 +1,61 @@
+"""What several commands share: the parser that fails in one line, and the scenario flags."""
+
+from __future__ import annotations
+
+import argparse
+
+from twin.exceptions import InvalidScenario
+from twin.experiments import arguments
+from twin.physics.model import Orientation
+from twin.plants import PLANTS, Plant
+from twin.plants.as_built import EFFECTS, as_built_plant
+from twin.sim.scenario import CONTROLLER_NAMES, Scenario
+
+EXIT_USAGE = 2
+
+
+class Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # one line, no usage dump
+        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+
+
+def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
+    """The scenario flags shared by ``run`` and later commands."""
+    parser.add_argument("--controller", choices=CONTROLLER_NAMES, required=True)
+    parser.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), required=True)
+    parser.add_argument("--payload", type=arguments.grams, default=0.0, metavar="GRAMS", help="mass at the link tip (g)")
+    parser.add_argument("--orientation", choices=[o.value for o in Orientation], default="horizontal")
+    parser.add_argument("--plant", choices=sorted(PLANTS), default="thesis")
+    parser.add_argument("--seed", type=arguments.seed, default=0)
+    parser.add_argument("--noise", action=argparse.BooleanOptionalAction, default=True,
+                        help="the thesis's sensor noise, seeded (default on)")
+    parser.add_argument("--supply-kpa", type=arguments.kpa, default=None, help="supply pressure (kPa gauge)")
+    parser.add_argument("--without", type=effects, default=(), metavar="EFFECT[,EFFECT]",
+                        help=f"as-built effects to switch off ({', '.join(EFFECTS)}); only with --plant as-built")
+
+
+def effects(text: str) -> tuple[str, ...]:
+    names = tuple(sorted({name.strip() for name in text.split(",") if name.strip()}))
+    unknown = [name for name in names if name not in EFFECTS]
+    if not names or unknown:
+        raise argparse.ArgumentTypeError(f"unknown as-built effect {', '.join(unknown) or repr(text)}: "
+                                         f"choose from {', '.join(EFFECTS)}")
+    return names
+
+
+def plant_of(args: argparse.Namespace) -> str | Plant:
+    """``--plant``, or the as-built plant with the ``--without`` effects switched off."""
+    if not args.without:
+        return args.plant
+    if args.plant != "as-built":
+        raise InvalidScenario(f"--without switches off as-built effects, but the plant is {args.plant!r}: "
+                              f"use --plant as-built")
+    return as_built_plant(without=args.without, name="as-built-without-" + "+".join(args.without))
+
+
+def scenario_from(args: argparse.Namespace) -> Scenario:
+    return Scenario(
+        controller=args.controller, trajectory=args.trajectory, payload=args.payload / 1e3,
+        orientation=Orientation(args.orientation), plant=plant_of(args), seed=args.seed, noise=args.noise,
+        supply_pressure=None if args.supply_kpa is None else args.supply_kpa * 1e3,
+    )

@@ -1,0 +1,47 @@
+"""``twin whatif NAME`` and ``twin study NAME``: every experiment driven the same way
+(:class:`twin.experiments.base.Experiment`): check the input, run, write, plot, answer."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+
+from twin.cli.common import Parser
+from twin.experiments import arguments
+from twin.experiments.base import Experiment
+from twin.experiments.studies import STUDIES
+from twin.experiments.whatifs import WHATIFS
+
+
+def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
+    """Exit 0, or 1 when some run failed, or 130 when interrupted (a resumable one keeps its runs)."""
+    experiment.check(args)  # bad input: a one-line error before anything is written
+    args.out.mkdir(exist_ok=True)
+    try:
+        outcome = experiment.run(args, args.out)
+    except KeyboardInterrupt:
+        if not experiment.resumable:
+            raise
+        print(f"interrupted: finished runs are kept in {args.out / 'results.sqlite'}; "
+              "run the same command again to finish the rest", file=sys.stderr)
+        return 130
+    paths = experiment.outputs(outcome, args.out)
+    print(outcome.answer)
+    print(f"wrote {', '.join(str(p) for p in paths)}")
+    return 1 if outcome.failed else 0
+
+
+def _group(sub, command: str, help_text: str, experiments: dict[str, Experiment]) -> None:
+    parser = sub.add_parser(command, help=help_text)
+    names = parser.add_subparsers(dest="experiment", required=True, parser_class=Parser, metavar="NAME")
+    for name, experiment in experiments.items():
+        one = names.add_parser(name, help=experiment.help)
+        one.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="output folder (created)")
+        experiment.add_arguments(one)
+        one.set_defaults(func=lambda args, experiment=experiment: run_experiment(experiment, args))
+
+
+def add_parser(sub) -> None:
+    _group(sub, "whatif", "payload, lift, PWM, gear-load and supply questions", WHATIFS)
+    _group(sub, "study", "the thesis's robustness protocol (ch. 6), open-loop validation (4.6), as-built ablation",
+           STUDIES)

@@ -1,0 +1,47 @@
+"""``twin run``: one scenario; its metrics, and optionally its trace, figure and 3D recording."""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from twin.cli.common import add_scenario_arguments, scenario_from
+from twin.experiments import arguments
+
+
+def _cmd_run(args: argparse.Namespace) -> int:
+    from twin.envs.runner import run
+    from twin.sim import report
+
+    result = run(scenario_from(args))
+    if args.trace:
+        report.write_trace(result, args.trace)
+    if args.plot:
+        from viz.plots import plot_run
+
+        plot_run(result, args.plot)
+    if args.html:
+        from viz.recording import write_recording
+
+        write_recording(result, args.html)
+    record = report.summary(result)
+    if args.json:
+        print(json.dumps(record))
+    else:
+        sse = "none (ends moving)" if record["sse_deg"] is None else f"{record['sse_deg']:.3f} deg"
+        print(f"RMSE {record['rmse_deg']:.3f} deg  SSE {sse}  "
+              f"max |e| {record['max_error_deg']:.3f} deg  ({record['duration_s']:.2f} s simulated)")
+        for warning in record["warnings"]:
+            print(f"warning: {warning}")
+    return 1 if result.warnings else 0
+
+
+def add_parser(sub) -> None:
+    run = sub.add_parser("run", help="simulate one scenario")
+    add_scenario_arguments(run)
+    run.add_argument("--trace", type=arguments.writable_file(".csv"), metavar="FILE.csv", help="write the time series")
+    run.add_argument("--plot", type=arguments.writable_file(".png"), metavar="FILE.png", help="write a figure")
+    run.add_argument("--json", action="store_true", help="print exactly one JSON object")
+    run.add_argument("--html", type=arguments.writable_file(".html"), metavar="FILE.html",
+                     help="write a self-contained 3D recording with its traces")
+    run.set_defaults(func=_cmd_run)

@@ -1,0 +1,64 @@
+"""``twin sweep``: a grid of scenarios on all cores (or Ray), resumable."""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+import sys
+
+from twin.experiments import arguments
+
+
+def _cmd_sweep(args: argparse.Namespace) -> int:
+    from tqdm import tqdm
+
+    from twin.batch import grid, tables
+    from twin.batch.sweep import open_store, run_sweep
+
+    axes = grid.read_toml(args.config) if args.config else {}
+    for name in grid.AXES:
+        value = getattr(args, name)
+        if value is not None:
+            axes[name] = grid.parse_axis(name, value)
+    points = grid.expand(axes)
+    args.out.mkdir(exist_ok=True)
+    open_store(args.out).close()  # refuses a store of another code version before any output
+    print(f"{len(points)} scenarios -> {args.out.resolve()}", file=sys.stderr)
+    bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
+    try:
+        outcome = run_sweep(points, out=args.out, workers=args.workers, backend=args.backend,
+                            address=args.ray_address, progress=bar.update)
+    except KeyboardInterrupt:
+        bar.close()
+        print(f"interrupted: finished scenarios are kept in {args.out / 'results.sqlite'}; "
+              "run the same command again to finish the rest", file=sys.stderr)
+        return 130
+    finally:
+        bar.close()
+    tables.write_results(outcome.records, args.out)
+    summary = tables.summarise(outcome.records)
+    tables.write_summary(summary, args.out)
+    from viz.sweep_plots import plot_summary
+
+    plot_summary(summary, args.out / "rmse.png")
+    print(tables.format_summary(summary))
+    failed = [r for r in outcome.records if r["status"] != "ok"]
+    for r in failed[:20]:
+        print(f"failed: {r['key']}: {r['reason']}", file=sys.stderr)
+    print(f"{outcome.ran} run, {outcome.skipped} already done, {len(failed)} failed; "
+          f"wrote results.csv, results.parquet, summary.csv, rmse.png in {args.out}")
+    return 1 if failed else 0
+
+
+def add_parser(sub) -> None:
+    sweep = sub.add_parser("sweep", help="a grid of scenarios on all cores (or Ray), resumable")
+    for name in ("controller", "trajectory", "payload", "orientation", "plant", "seed", "supply_kpa", "pwm_period_ms"):
+        sweep.add_argument("--" + name.replace("_", "-"), dest=name, metavar="LIST",
+                           help="comma list; numbers also start:stop:step; seeds also a-b")
+    sweep.add_argument("--config", type=pathlib.Path, metavar="GRID.toml", help="axes from a TOML file")
+    sweep.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="results folder (created)")
+    sweep.add_argument("--workers", type=arguments.positive_int, default=None,
+                       help="processes (default: all cores); with Ray, CPUs to size chunks for (default: the cluster's)")
+    sweep.add_argument("--backend", choices=("local", "ray"), default="local")
+    sweep.add_argument("--ray-address", default=None, help="Ray cluster address (default: RAY_ADDRESS or local)")
+    sweep.set_defaults(func=_cmd_sweep)

@@ -1,0 +1,52 @@
+"""``twin view``: the joint live in a browser."""
+
+from __future__ import annotations
+
+import argparse
+import signal
+import sys
+import time
+
+from twin.cli.common import add_scenario_arguments, scenario_from
+from twin.experiments import arguments
+
+
+def _cmd_view(args: argparse.Namespace) -> int:
+    from viz.live_server import LiveSession, LiveViewer
+
+    session = LiveSession(scenario_from(args), record=args.html is not None)
+    viewer = LiveViewer(session, host=args.host, port=args.port, speed=args.speed)
+    if args.host not in ("127.0.0.1", "localhost", "::1"):
+        print(f"warning: serving on {args.host}: anyone who can reach it can drive the twin", file=sys.stderr)
+    print(f"twin view: open {viewer.url}  (Ctrl-C to stop)", flush=True)
+    if args.duration is not None:
+        stop_at = time.monotonic() + args.duration
+        viewer.on_frame = lambda: viewer.stop() if time.monotonic() >= stop_at else None
+    signal.signal(signal.SIGTERM, signal.default_int_handler)  # stop (and write --html) on SIGTERM too
+    try:
+        viewer.start()
+    except KeyboardInterrupt:
+        viewer.stop()
+    print("twin view: stopped", flush=True)
+    if args.html is not None:
+        print(f"writing {args.html} ...", flush=True)
+        try:
+            session.write_html(args.html)
+        except KeyboardInterrupt:
+            print("twin view: interrupted; no recording written", file=sys.stderr)
+            return 130
+        print(f"wrote {args.html}", flush=True)
+    return 1 if viewer.failure else 0
+
+
+def add_parser(sub) -> None:
+    view = sub.add_parser("view", help="the joint live in a browser (3D view and control panel)")
+    add_scenario_arguments(view)
+    view.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1 only)")
+    view.add_argument("--port", type=arguments.port, default=7000, help="TCP port (default 7000; 0: any free port)")
+    view.add_argument("--speed", type=arguments.speed, default=1.0, help="simulated seconds per second (default 1)")
+    view.add_argument("--duration", type=arguments.seconds, default=None, metavar="SECONDS",
+                      help="stop after this many seconds of wall time (default: run until Ctrl-C)")
+    view.add_argument("--html", type=arguments.writable_file(".html"), metavar="FILE.html",
+                      help="on stopping, write a recording of the last model's run (up to 10 min)")
+    view.set_defaults(func=_cmd_view)

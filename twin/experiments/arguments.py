@@ -1,0 +1,60 @@
+"""Argument types of the command line, in edge units (degrees, grams, kPa, ms): each parses one
+flag's text or raises ``argparse.ArgumentTypeError`` with a one-line reason. The CLI and the
+experiments' own flags share them."""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import pathlib
+
+
+def writable_file(suffix: str):
+    """An argparse type for an output file with ``suffix`` in an existing, writable folder."""
+    def check(text: str) -> pathlib.Path:
+        path = pathlib.Path(text)
+        if path.suffix.lower() != suffix:
+            raise argparse.ArgumentTypeError(f"{text!r} must end in {suffix}")
+        if not path.parent.is_dir():
+            raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} of {text!r} does not exist")
+        if path.is_dir():
+            raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
+        if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+            raise argparse.ArgumentTypeError(f"cannot write {text!r}")
+        return path
+
+    return check
+
+
+def checked(kind: type, accept, requirement: str):
+    """An argparse type: parse with ``kind``, keep it if ``accept(value)``, else name the bad text."""
+    def parse(text: str):
+        try:
+            value = kind(text)
+        except ValueError:
+            value = None
+        if value is None or not math.isfinite(value) or not accept(value):
+            raise argparse.ArgumentTypeError(f"{requirement}, got {text!r}")
+        return value
+
+    return parse
+
+
+def out_dir(text: str) -> pathlib.Path:
+    """An output folder: created later, so only its parent must exist."""
+    path = pathlib.Path(text)
+    if not path.parent.exists():
+        raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
+    if path.exists() and not path.is_dir():
+        raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
+    return path
+
+
+grams = checked(float, lambda v: v >= 0, "payload must be a non-negative number of grams")
+kpa = checked(float, lambda v: 0 < v <= 700, "supply pressure must be in (0, 700] kPa (cylinder rating)")
+seed = checked(int, lambda v: v >= 0, "seed must be a non-negative integer")
+positive_int = checked(int, lambda v: v >= 1, "expected a positive integer")
+port = checked(int, lambda v: 0 <= v <= 65535, "port must be an integer in [0, 65535]")
+speed = checked(float, lambda v: 0 < v <= 10, "speed must be in (0, 10] times real time")
+seconds = checked(float, lambda v: v > 0, "duration must be a positive number of seconds")

@@ -1,0 +1,72 @@
+"""One interface for every experiment the CLI runs: what-ifs (``twin whatif NAME``) and studies
+(``twin study NAME``).
+
+An experiment is a module-level object with
+
+``name``           the command word and the stem of its output files (``DIR/NAME.csv`` ...)
+``help``           one line for ``--help``
+``add_arguments``  its own flags (``--out`` is added for it)
+``check(args)``    every input checked, raising :class:`twin.exceptions.InvalidScenario`, before
+                   anything is written
+``run(args, out)`` the work, returning an :class:`Outcome`
+``write``          the outcome's files: ``NAME.csv`` (its rows) and ``NAME.txt`` (its answer) unless
+                   the experiment writes others
+``plot``           ``NAME.png``
+
+:func:`run_experiment` drives one through that order, so a new what-if is one new module
+registered in :mod:`twin.experiments.whatifs`.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import pathlib
+from typing import Any, ClassVar
+
+from twin.batch.tables import write_csv
+
+
+@dataclasses.dataclass(frozen=True)
+class Outcome:
+    """What an experiment found: rows (one per CSV line, edge units: deg, g, kPa, ms), the short
+    answer, how many runs failed, and whatever else its plot draws."""
+
+    rows: list[dict]
+    answer: str
+    failed: int = 0
+    detail: Any = None
+
+
+class Experiment:
+    """Base of the experiments: the defaults of the interface above."""
+
+    name: ClassVar[str]
+    help: ClassVar[str]
+    resumable: ClassVar[bool] = False  # keeps finished runs in DIR/results.sqlite across interruptions
+
+    def add_arguments(self, parser: argparse.ArgumentParser) -> None:
+        """Flags of this experiment (``--out`` is common)."""
+
+    def check(self, args: argparse.Namespace) -> None:
+        """Raise InvalidScenario for bad input, before any output exists."""
+
+    def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
+        raise NotImplementedError
+
+    def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
+        """``NAME.csv`` and ``NAME.txt``."""
+        csv_path, txt_path = out / f"{self.name}.csv", out / f"{self.name}.txt"
+        write_csv(outcome.rows, list(outcome.rows[0]), csv_path)
+        txt_path.write_text(outcome.answer + "\n")
+        return [csv_path, txt_path]
+
+    def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
+        raise NotImplementedError
+
+    def outputs(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
+        """Write the files and the plot; the paths written, the plot last."""
+        paths = self.write(outcome, out)
+        png = out / f"{self.name}.png"
+        self.plot(outcome, png)
+        return paths + [png]

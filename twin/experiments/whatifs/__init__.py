@@ -1,0 +1,17 @@
+"""``twin whatif NAME``: gravity, payload, supply and PWM questions, one module each, every one an
+:class:`twin.experiments.base.Experiment` (a table, a plot and a short answer).
+
+payload    tracking against tip payload, both orientations, until the joint no longer follows
+lift       the heaviest payload lifted vertically against supply pressure
+pwm        tracking against the valves' PWM period alone (SPEC §10)
+gear-load  gear tooth forces against the Lewis safe loads
+supply     the as-built supply line against an accumulator and a constant supply (SPEC §10)
+
+A new what-if is a new module with an ``EXPERIMENT`` object, listed in ``WHATIFS``.
+"""
+
+from __future__ import annotations
+
+from twin.experiments.whatifs import gear_load, lift, payload, pwm, supply
+
+WHATIFS = {module.EXPERIMENT.name: module.EXPERIMENT for module in (payload, lift, pwm, gear_load, supply)}

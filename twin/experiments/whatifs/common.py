@@ -1,0 +1,39 @@
+"""What the what-ifs share: their common flags, list flags parsed as sweep axes, a progress bar."""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import sys
+
+from twin.batch import grid
+from twin.exceptions import InvalidScenario
+from twin.experiments.arguments import positive_int
+from twin.plants import PLANTS
+
+
+def add_common_arguments(parser: argparse.ArgumentParser, default_plant: str, *, seeds: bool = True) -> None:
+    parser.add_argument("--plant", choices=sorted(PLANTS), default=default_plant, help=f"default {default_plant}")
+    if seeds:
+        parser.add_argument("--seeds", type=positive_int, default=3, help="noise seeds per case (default 3)")
+
+
+def list_flag(args: argparse.Namespace, flag: str, attribute: str, axis: str) -> list:
+    """The list flag ``flag`` parsed as the sweep axis ``axis`` (edge units), with every scenario it
+    implies on ``args.plant`` built, so bad input fails before anything is written; errors name ``flag``."""
+    try:
+        values = grid.parse_axis(axis, getattr(args, attribute))
+        grid.expand({axis: values, "plant": [args.plant]})
+    except InvalidScenario as error:
+        message = str(error).replace(f"--{axis.replace('_', '-')}", flag)  # grid names its own flag (--payload)
+        raise InvalidScenario(message if flag in message else f"{flag}: {message}") from None
+    return values
+
+
+@contextlib.contextmanager
+def progress_bar(name: str):
+    """A scenario-counting progress bar on stderr, labelled ``name``."""
+    from tqdm import tqdm
+
+    with tqdm(unit="scenario", file=sys.stderr, dynamic_ncols=True, desc=name) as bar:
+        yield bar

@@ -1,0 +1,70 @@
+"""``twin whatif payload``: RMSE, SSE and max error against tip payload, both orientations, both
+model-based controllers, up to where the joint can no longer follow (max |error| above
+FOLLOW_LIMIT_DEG in any seed). Runs through the sweep engine, resumable from ``DIR/payload-runs``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+from collections.abc import Sequence
+
+from twin.batch.grid import expand
+from twin.batch.sweep import run_sweep
+from twin.batch.tables import summarise
+from twin.experiments.arguments import positive_int
+from twin.experiments.base import Experiment, Outcome
+from twin.experiments.whatifs.common import add_common_arguments, list_flag, progress_bar
+from viz.sweep_plots import plot_summary
+
+FOLLOW_LIMIT_DEG = 10.0  # max |error| beyond which the joint "no longer follows"
+
+
+def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory: int = 1, seeds: int = 3,
+                  plant_name: str = "thesis", workers: int | None = None, progress=None) -> Outcome:
+    points = expand({"controller": ["ffpva", "smc"], "trajectory": [trajectory], "payload": list(payloads_g),
+                     "orientation": ["horizontal", "vertical"], "plant": [plant_name], "seed": list(range(seeds))})
+    records = run_sweep(points, out=out, workers=workers, progress=progress).records
+    rows = summarise(records)
+    lines = []
+    for controller in ("ffpva", "smc"):
+        for orientation in ("horizontal", "vertical"):
+            group = sorted((r for r in rows if r["controller"] == controller and r["orientation"] == orientation),
+                           key=lambda r: r["payload_g"])
+            following = [r for r in group if r["failed"] == 0 and r["max_error_deg"] <= FOLLOW_LIMIT_DEG]
+            last_ok = max((r["payload_g"] for r in following), default=None)
+            first_bad = next((r["payload_g"] for r in group
+                              if r["failed"] or r["max_error_deg"] > FOLLOW_LIMIT_DEG), None)
+            reach = (f"follows T{trajectory} up to {last_ok:g} g" if last_ok is not None else "never follows")
+            reach += f", not at {first_bad:g} g" if first_bad is not None else " (the whole range)"
+            rmse = ", ".join(f"{r['payload_g']:g} g: {r['rmse_mean_deg']:.2f}" for r in group[:: max(1, len(group) // 4)])
+            lines.append(f"{controller} {orientation}: {reach}; RMSE (deg) {rmse}")
+    return Outcome(rows, "\n".join(lines))
+
+
+class PayloadWhatIf(Experiment):
+    name = "payload"
+    help = "tracking against tip payload, horizontal and vertical"
+    default_plant = "thesis"
+
+    def add_arguments(self, parser: argparse.ArgumentParser) -> None:
+        add_common_arguments(parser, self.default_plant)
+        parser.add_argument("--payloads", default="0:30:2.5", metavar="LIST", help="grams (default 0:30:2.5)")
+        parser.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), default=1)
+        parser.add_argument("--workers", type=positive_int, default=None, help="processes (default: all cores)")
+
+    def check(self, args: argparse.Namespace) -> None:
+        args.payload_values = list_flag(args, "--payloads", "payloads", "payload")
+
+    def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
+        store = out / "payload-runs"
+        store.mkdir(exist_ok=True)
+        with progress_bar(self.name) as bar:
+            return payload_study(out=store, payloads_g=args.payload_values, trajectory=args.trajectory,
+                                 seeds=args.seeds, plant_name=args.plant, workers=args.workers, progress=bar.update)
+
+    def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
+        plot_summary(outcome.rows, path)
+
+
+EXPERIMENT = PayloadWhatIf()
