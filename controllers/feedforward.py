@@ -41,7 +41,7 @@ class NominalModel:
 
     @classmethod
     def thesis(cls, params: JointParams = NOMINAL_PARAMS) -> NominalModel:
-        return cls(supply_pressure=300e3, mass=params.masses.thesis_total_mass,
+        return cls(supply_pressure=NOMINAL_PARAMS.supply.pressure, mass=params.masses.thesis_total_mass,
                    bore_area=params.cylinder.bore_area, valves=params.valves, friction=params.friction)
 
 

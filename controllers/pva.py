@@ -16,10 +16,11 @@ import dataclasses
 import numpy as np
 
 from twin.exceptions import InvalidController
+from twin.physics.params import NOMINAL_PARAMS
 from twin.physics.ticks import whole_ticks
 from twin.sim.control import Measurement, Setpoint
 
-PWM_PERIOD = 16e-3  # s, the controller runs once per PWM period (§6)
+PWM_PERIOD = NOMINAL_PARAMS.valves.pwm_period  # s (16 ms), the controller runs once per PWM period (§6)
 
 
 @dataclasses.dataclass(frozen=True)

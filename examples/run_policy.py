@@ -14,7 +14,7 @@ import math
 from controllers import make_controller
 from controllers.feedforward import NominalModel
 from controllers.policy import ControllerPolicy
-from twin.envs import env as joint_env
+from twin.envs import environment as joint_env
 
 
 def main() -> None:

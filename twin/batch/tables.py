@@ -8,18 +8,12 @@ import math
 import pathlib
 from collections.abc import Sequence
 
-import numpy as np
-
 from twin.batch.store import COLUMNS
+from twin.sim.metrics import spread
 
 GROUP_BY = ("controller", "trajectory", "payload_g", "orientation", "plant", "supply_kpa", "pwm_period_ms")
 SUMMARY_COLUMNS = GROUP_BY + ("runs", "failed", "rmse_mean_deg", "rmse_std_deg", "rmse_min_deg", "rmse_max_deg",
                               "sse_mean_deg", "sse_min_deg", "sse_max_deg", "max_error_deg")
-
-
-def sample_std(values: Sequence[float]) -> float:
-    """The std of runs as the thesis's tables give it (ddof 1); 0 for a single run."""
-    return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
 
 
 def write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
@@ -51,13 +45,12 @@ def summarise(rows: Sequence[dict]) -> list[dict]:
     summary = []
     for key, members in groups.items():
         ok = [r for r in members if r["status"] == "ok"]
-        rmse = np.array([r["rmse_deg"] for r in ok]) if ok else np.array([math.nan])
-        sse = np.array([math.nan if r["sse_deg"] is None else r["sse_deg"] for r in ok]) if ok else np.array([math.nan])
+        rmse = spread([r["rmse_deg"] for r in ok] if ok else [math.nan])
+        sse = spread([math.nan if r["sse_deg"] is None else r["sse_deg"] for r in ok] if ok else [math.nan])
         summary.append({
             **dict(zip(GROUP_BY, key, strict=True)), "runs": len(members), "failed": len(members) - len(ok),
-            "rmse_mean_deg": float(np.mean(rmse)), "rmse_std_deg": sample_std(rmse),
-            "rmse_min_deg": float(np.min(rmse)), "rmse_max_deg": float(np.max(rmse)),
-            "sse_mean_deg": float(np.mean(sse)), "sse_min_deg": float(np.min(sse)), "sse_max_deg": float(np.max(sse)),
+            "rmse_mean_deg": rmse.mean, "rmse_std_deg": rmse.std, "rmse_min_deg": rmse.min, "rmse_max_deg": rmse.max,
+            "sse_mean_deg": sse.mean, "sse_min_deg": sse.min, "sse_max_deg": sse.max,
             "max_error_deg": float(max((r["max_error_deg"] for r in ok), default=math.nan)),
         })
     return summary

@@ -11,6 +11,7 @@ from collections.abc import Callable, Sequence
 
 from controllers import make_controller
 from controllers.feedforward import NominalModel
+from twin.exceptions import InvalidScenario
 from twin.physics.params import NOMINAL_PARAMS
 from twin.sim.scenario import Scenario
 from twin.sim.simulation import Result, simulate
@@ -29,6 +30,9 @@ def thesis_controllers(scenarios: Sequence[Scenario]) -> list:
     shared: dict = {}
     chosen = []
     for s in scenarios:
+        if s.controller is None:
+            raise InvalidScenario("a scenario without a controller cannot be run by name: pass its controller to "
+                                  "twin.sim.simulation.simulate")
         preset = s.preset
         key = (s.controller, preset.gain_set, nominal_model(preset), preset.timestep)
         if key not in shared:

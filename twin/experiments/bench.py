@@ -120,7 +120,7 @@ def _env_cost(trajectory: int, duration: float) -> float:
     from controllers import make_controller
     from controllers.feedforward import NominalModel
     from controllers.policy import ControllerPolicy
-    from twin.envs import env as joint_env
+    from twin.envs import environment as joint_env
 
     controller = make_controller("ffpva", nominal=NominalModel.thesis(), gain_set="simulation", tick=1e-3)
     environment = joint_env.load("track", trajectory=trajectory, seed=0)

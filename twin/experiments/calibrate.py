@@ -36,9 +36,9 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from twin.batch.sweep import code_version
-from twin.batch.tables import sample_std
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG
 from twin.plants.as_built import ASSUMED, FITTED, as_built_plant
+from twin.sim.metrics import spread
 from twin.sim.scenario import Scenario
 
 THESIS_RUNS = 5  # runs per cell in the thesis's Chapter 5 table
@@ -67,7 +67,7 @@ class CellResult:
 
     @property
     def mean_rmse(self) -> float:
-        return float(np.mean(self.rmse_deg))
+        return spread(self.rmse_deg).mean
 
     @property
     def sse_range(self) -> float:
@@ -236,10 +236,10 @@ def cell_rows(cells: Sequence[CellResult]) -> list[dict]:
     """One row per cell: the experiment's RMSE and std, the twin's, their ratio, the T1 SSE ranges."""
     rows = []
     for cell in cells:
-        target, spread = THESIS_EXPERIMENT_RMSE_DEG[cell.controller][cell.trajectory]
+        target, target_std = THESIS_EXPERIMENT_RMSE_DEG[cell.controller][cell.trajectory]
         rows.append({"controller": cell.controller, "trajectory": cell.trajectory,
-                     "experiment_rmse_deg": target, "experiment_std_deg": spread,
-                     "twin_rmse_deg": round(cell.mean_rmse, 4), "twin_std_deg": round(sample_std(cell.rmse_deg), 4),
+                     "experiment_rmse_deg": target, "experiment_std_deg": target_std,
+                     "twin_rmse_deg": round(cell.mean_rmse, 4), "twin_std_deg": round(spread(cell.rmse_deg).std, 4),
                      "ratio": round(cell.mean_rmse / target, 4),
                      "twin_sse_range_deg": None if math.isnan(cell.sse_range) else round(cell.sse_range, 4),
                      "experiment_sse_range_deg": THESIS_EXPERIMENT_SSE_T1_RANGE_DEG.get(cell.controller)

@@ -16,7 +16,6 @@ import sys
 import numpy as np
 from tqdm import tqdm
 
-from twin.batch.tables import sample_std
 from twin.envs.runner import run_many
 from twin.experiments.reference import (
     THESIS_SIMULATED_RMSE_DEG,
@@ -24,6 +23,7 @@ from twin.experiments.reference import (
     THESIS_SIMULATED_T4_REST_ERRORS_DEG,
 )
 from twin.sim import report
+from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS, CONTROLLER_NAMES, TRAJECTORY_NUMBERS, Scenario
 from twin.sim.simulation import Result
 
@@ -40,15 +40,15 @@ def summary_rows(results: list[Result]) -> list[dict]:
         for t in TRAJECTORY_NUMBERS:
             records = [report.summary(r) for r in results
                        if r.scenario.controller == c and r.scenario.trajectory == t]
-            rmse = np.array([r["rmse_deg"] for r in records])
-            sse = np.array([np.nan if r["sse_deg"] is None else r["sse_deg"] for r in records])
-            peak = np.array([r["max_error_deg"] for r in records])
+            rmse = spread([r["rmse_deg"] for r in records])
+            sse = spread([np.nan if r["sse_deg"] is None else r["sse_deg"] for r in records])
+            peak = spread([r["max_error_deg"] for r in records])
             thesis = THESIS_SIMULATED_RMSE_DEG.get(c, {}).get(t)
             rows.append({
                 "controller": c, "trajectory": t, "runs": len(records),
-                "rmse_mean": rmse.mean(), "rmse_std": sample_std(rmse),
-                "sse_mean": sse.mean(), "sse_min": sse.min(), "sse_max": sse.max(),
-                "max_error_mean": peak.mean(), "thesis_rmse": thesis,
+                "rmse_mean": rmse.mean, "rmse_std": rmse.std,
+                "sse_mean": sse.mean, "sse_min": sse.min, "sse_max": sse.max,
+                "max_error_mean": peak.mean, "thesis_rmse": thesis,
                 "thesis_sse": THESIS_SIMULATED_SSE_T1_DEG.get(c) if t == 1 else None,
                 "warnings": sum(len(r["warnings"]) for r in records),
             })

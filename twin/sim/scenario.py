@@ -18,7 +18,7 @@ TRAJECTORY_NUMBERS = (1, 2, 3, 4)
 
 @dataclasses.dataclass(frozen=True)
 class Scenario:
-    controller: str  # "pva", "ffpva" or "smc"
+    controller: str | None  # "pva", "ffpva" or "smc"; None where the caller brings its own (open loop, lift)
     trajectory: int  # 1..4
     payload: float = 0.0  # kg at the link tip
     orientation: Orientation = Orientation.HORIZONTAL
@@ -29,7 +29,7 @@ class Scenario:
     pwm_period: float | None = None  # s; None: the plant's (16 ms); a whole number of ticks
 
     def __post_init__(self) -> None:
-        if self.controller not in CONTROLLER_NAMES:
+        if self.controller is not None and self.controller not in CONTROLLER_NAMES:
             raise InvalidScenario(f"unknown controller {self.controller!r}: choose one of {', '.join(CONTROLLER_NAMES)}")
         if self.trajectory not in TRAJECTORY_NUMBERS:
             raise InvalidScenario(f"unknown trajectory {self.trajectory!r}: choose 1, 2, 3 or 4")

@@ -92,7 +92,7 @@ def openloop_run(plant_name: str) -> OpenLoopRun:
     from twin.sim.scenario import Scenario
     from twin.sim.simulation import simulate
 
-    scenario = Scenario("ffpva", OPENLOOP_TRAJECTORY, plant=plant_name, noise=False)  # the name is unused
+    scenario = Scenario(None, OPENLOOP_TRAJECTORY, plant=plant_name, noise=False)
     result = simulate([scenario], controllers=[openloop_controller(scenario.preset.timestep)])[0]
     tr = result.trace
     velocity = np.diff(tr.angle, prepend=tr.angle[0]) / scenario.preset.timestep  # rad/s, reached at each tick

@@ -48,7 +48,7 @@ def _lifts(payloads: np.ndarray, pressures: np.ndarray, plant_name: str) -> np.n
     from controllers.open_loop import OpenLoop
     from twin.sim.simulation import simulate
 
-    scenarios = [Scenario("ffpva", 3, payload=float(m), orientation=Orientation.VERTICAL, plant=plant_name,
+    scenarios = [Scenario(None, 3, payload=float(m), orientation=Orientation.VERTICAL, plant=plant_name,
                           noise=False, supply_pressure=float(p)) for m, p in zip(payloads, pressures, strict=True)]
     opener = OpenLoop(schedule=lambda t: 100.0, tick=plant(plant_name).timestep)
     results = simulate(scenarios, controllers=[opener] * len(scenarios))

@@ -20,7 +20,7 @@ from twin.batch.store import COLUMNS, ResultStore, StaleStore
 from twin.batch.sweep import WorkerLost, failed_record, make_chunks, run_chunk, run_sweep
 from twin.exceptions import InvalidScenario
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 AXES = {"controller": ["ffpva", "smc"], "trajectory": [1, 2], "payload": [0.0, 13.5],
         "orientation": ["vertical"], "seed": [0, 1, 2]}
 

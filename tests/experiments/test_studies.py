@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 
 from controllers.open_loop import ReversingSine
-from twin.experiments import ablation, studies
+from twin.experiments.studies import ablation, openloop, robustness
 from twin.experiments.calibrate import CELLS, Evaluator
-from twin.experiments.studies import Reversal, paired_reversals, reversal_lags
+from twin.experiments.studies.openloop import Reversal, paired_reversals, reversal_lags
 from twin.plants import PLANTS
 from twin.plants.as_built import EFFECTS, calibrated_values
 from twin.sim.control import Measurement, Setpoint
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"
 H = 1e-3  # s, tick
 
@@ -37,7 +37,7 @@ def _rows(path: pathlib.Path) -> tuple[list[str], list[dict]]:
 # --- robustness -------------------------------------------------------------------------------------------------
 
 def test_robustness_grid_is_the_chapter_6_protocol():
-    points = studies.robustness_grid(plant_name="thesis")
+    points = robustness.robustness_grid(plant_name="thesis")
     assert len(points) == 120 and len({p.key for p in points}) == 120
     cases = {(p.controller, p.trajectory, p.payload_g, p.orientation, p.seed) for p in points}
     assert cases == set(itertools.product(("ffpva", "smc"), (1, 3), (0.0, 6.5, 13.5), ("horizontal", "vertical"),
@@ -50,15 +50,15 @@ def test_robustness_grid_is_the_chapter_6_protocol():
 
 def test_default_plant_is_as_built_only_when_it_exists(monkeypatch):
     monkeypatch.delitem(PLANTS, "as-built", raising=False)
-    assert studies.default_plant("thesis") == "thesis"
-    assert studies.default_plant("thesis-pwm") == "thesis-pwm"
+    assert robustness.default_plant("thesis") == "thesis"
+    assert robustness.default_plant("thesis-pwm") == "thesis-pwm"
     monkeypatch.setitem(PLANTS, "as-built", PLANTS["thesis"])
-    assert studies.default_plant("thesis") == "as-built"
+    assert robustness.default_plant("thesis") == "as-built"
 
 
 def test_reduced_robustness_run_writes_three_files_and_marks_a_failed_run(tmp_path, monkeypatch):
     import twin.envs.runner
-    from viz.study_plots import plot_robustness
+    from twin.experiments.studies.robustness import plot_robustness
 
     real = twin.envs.runner.run_many
 
@@ -68,8 +68,8 @@ def test_reduced_robustness_run_writes_three_files_and_marks_a_failed_run(tmp_pa
                 == ("smc", 13.5e-3, "vertical") else r for r in real(scenarios, **kwargs)]
 
     monkeypatch.setattr(twin.envs.runner, "run_many", with_a_warning)
-    study = studies.robustness_study(out=tmp_path, plant_name="thesis", seeds=1, trajectories=(1,), workers=1)
-    studies.write_robustness(study, tmp_path)
+    study = robustness.robustness_study(out=tmp_path, plant_name="thesis", seeds=1, trajectories=(1,), workers=1)
+    robustness.write_robustness(study, tmp_path)
     plot_robustness(study.runs, tmp_path / "robustness.png")
 
     columns, runs = _rows(tmp_path / "robustness_runs.csv")
@@ -97,14 +97,14 @@ def test_reduced_robustness_run_writes_three_files_and_marks_a_failed_run(tmp_pa
             assert s["rmse_std_deg"] == ""  # one seed: no spread
     assert (tmp_path / "robustness.png").read_bytes().startswith(PNG_MAGIC)
 
-    from viz.study_plots import robustness_figure
+    from twin.experiments.studies.robustness import robustness_figure
     figure = robustness_figure(study.runs)
     (axis,) = figure.axes
     dots = [y for line in axis.lines if line.get_marker() == "o" for y in line.get_ydata()]
     assert sorted(dots) == sorted(r["rmse_deg"] for r in study.runs if r["status"] == "ok")  # the failed one is not drawn
     assert "1 failed" in axis.get_title()
 
-    table = studies.format_robustness(study)
+    table = robustness.format_robustness(study)
     assert "T1: steady-state error per run" in table and "T1: RMSE per run, mean and std" in table
     assert "12 runs, 1 failed" in table and "mjWARN_BADQACC" in table
     assert "T3" not in table
@@ -116,7 +116,7 @@ def test_summary_gives_the_thesis_sse_range_and_drops_failed_runs():
                 "plant": "thesis", "supply_kpa": None, "pwm_period_ms": None, "seed": seed, "rmse_deg": rmse,
                 "sse_deg": sse, "max_error_deg": 2 * rmse, "status": status}
 
-    rows = studies.summary_rows([record(0, 1.0, 0.2), record(1, 2.0, -0.5), record(2, 3.0, 0.1),
+    rows = robustness.summary_rows([record(0, 1.0, 0.2), record(1, 2.0, -0.5), record(2, 3.0, 0.1),
                                  record(3, 50.0, 9.0, "failed")])
     assert len(rows) == 1
     row = rows[0]
@@ -128,7 +128,7 @@ def test_summary_gives_the_thesis_sse_range_and_drops_failed_runs():
 
 # --- open loop: the duty --------------------------------------------------------------------------------------
 
-LOW, HIGH = studies.SOFT_LIMITS
+LOW, HIGH = openloop.SOFT_LIMITS
 MIDDLE = (LOW + HIGH) / 2
 
 
@@ -146,7 +146,7 @@ def test_soft_limits_are_inside_the_friction_fit():
 
 
 def test_openloop_duty_is_the_thesis_sine_stepped_every_16_ms():
-    controller = studies.openloop_controller(H)
+    controller = openloop.openloop_controller(H)
     assert controller.period == pytest.approx(16e-3)
     controller.reset(1)
     steps = np.arange(201)
@@ -191,7 +191,7 @@ def test_openloop_controller_checks_its_arguments():
 
 
 def test_openloop_run_holds_each_duty_16_ms_and_turns_back_at_the_limits():
-    run = studies.openloop_run("thesis")
+    run = openloop.openloop_run("thesis")
     assert len(run.time) == 3000 and not run.warnings  # 3 s of 1 ms ticks
     blocks = run.duty[:2992].reshape(-1, 16)  # whole 16 ms steps (3000 ticks leave a tail of 8)
     assert np.all(blocks == blocks[:, :1])
@@ -261,7 +261,7 @@ def twin(cwd: pathlib.Path, *args: str) -> subprocess.CompletedProcess:
 def test_cli_openloop_writes_the_csv_and_the_figure(tmp_path):
     proc = twin(tmp_path, "study", "openloop", "--out", "ol")
     assert proc.returncode == 0, proc.stderr
-    chosen = studies.default_plant("thesis-pwm")
+    chosen = robustness.default_plant("thesis-pwm")
     columns, rows = _rows(tmp_path / "ol" / "openloop.csv")
     assert columns == ["t_s", "duty_thesis-deadzone_pct", "angle_thesis-deadzone_deg", f"duty_{chosen}_pct",
                        f"angle_{chosen}_deg"]

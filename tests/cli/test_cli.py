@@ -14,7 +14,7 @@ import pytest
 
 from twin.sim.report import TRACE_COLUMNS
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 REQUIRED_KEYS = {"controller", "trajectory", "payload_g", "orientation", "plant", "seed", "rmse_deg",
                  "sse_deg", "max_error_deg", "duration_s", "warnings"}
 PNG_MAGIC = b"\x89PNG\r\n\x1a\n"

@@ -16,12 +16,14 @@ import pytest
 import controllers
 from tests.conftest import open_loop
 from twin.cli import main
-from twin.experiments.whatif import lift_study, mesh_loads, pwm_study
+from twin.experiments.whatifs.gear_load import mesh_loads
+from twin.experiments.whatifs.lift import lift_study
+from twin.experiments.whatifs.pwm import pwm_study
 from twin.physics.gears import lewis_safe_load
 from twin.physics.model import Orientation
 from twin.physics.params import GearParams, JointParams
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 COULOMB = (-3.051e14, 1.587e13, -3.244e11, 3.294e9, -1.727e7, 4.36e4, -39.551)  # eq. 4.5.7
 
 
@@ -150,7 +152,7 @@ def test_supply_variants_differ_in_the_supply_alone_and_sag_as_their_compliance_
     import dataclasses
 
     from twin.envs.runner import run_many
-    from twin.experiments.whatif import SUPPLY_MODELS, supply_variants
+    from twin.experiments.whatifs.supply import SUPPLY_MODELS, supply_variants
     from twin.plants import plant
     from twin.sim.scenario import Scenario
 

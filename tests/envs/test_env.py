@@ -12,7 +12,7 @@ from dm_env import test_utils
 from controllers import make_controller
 from controllers.feedforward import NominalModel
 from controllers.policy import ControllerPolicy
-from twin.envs import env as joint_env
+from twin.envs import environment as joint_env
 from twin.envs.runner import run
 from twin.exceptions import InvalidScenario
 from twin.physics.model import Orientation
