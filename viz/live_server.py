@@ -18,6 +18,7 @@ rather than skipping physics.
 from __future__ import annotations
 
 import dataclasses
+import importlib.resources
 import json
 import math
 import os
@@ -51,7 +52,7 @@ MAX_LAG_FRAMES = 3.0  # a late picture catches up at most this many frames of si
 MAX_MESSAGE_BYTES = 4096  # tornado refuses larger WebSocket messages before they are read
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 MAX_RECORDED_FRAMES = 10 * 60 * FPS  # a --html recording keeps the last 10 minutes
-PAGE = pathlib.Path(__file__).with_name("live_page.html")
+PAGE = importlib.resources.files("viz") / "live_page.html"  # package data
 
 
 class ServerError(TwinError):

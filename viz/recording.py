@@ -9,6 +9,7 @@ from __future__ import annotations
 import base64
 import dataclasses
 import html
+import importlib.resources
 import io
 import json
 import pathlib
@@ -23,8 +24,8 @@ from twin.sim.simulation import Result
 from viz.scene import Frame, JointScene
 
 FPS = 50  # animation frames per second of simulated time
-PAGE = pathlib.Path(__file__).with_name("recording_page.html")
-MESHCAT_SCRIPT = pathlib.Path(__import__("meshcat").__file__).parent / "viewer" / "dist" / "main.min.js"
+PAGE = importlib.resources.files("viz") / "recording_page.html"  # package data
+MESHCAT_SCRIPT = importlib.resources.files("meshcat") / "viewer" / "dist" / "main.min.js"
 
 
 @dataclasses.dataclass(frozen=True)

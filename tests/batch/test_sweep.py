@@ -210,6 +210,7 @@ def test_a_scenario_that_raises_is_marked_failed_with_its_reason(monkeypatch):
     assert "boom on seed 1" in rows[1]["reason"]
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_sigkill_midway_then_rerun_gives_every_scenario_once_and_the_same_numbers(tmp_path):
     args = ["--controller", "pva,ffpva,smc", "--trajectory", "2", "--seed", "0-11", "--workers", "2"]
     reference = _cli(*args, "--out", "ref", cwd=tmp_path)
@@ -290,6 +291,7 @@ def test_ray_chunks_follow_the_cluster_cpus_or_workers(tmp_path, monkeypatch, wo
     assert fake.init_kwargs["log_to_driver"] is False
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_ray_backend_gives_the_same_numbers_as_local(tmp_path):
     ray = pytest.importorskip("ray")
     points = grid.expand({"controller": ["ffpva", "smc"], "trajectory": [2], "seed": [0, 1]})

@@ -138,6 +138,7 @@ def test_a_run_with_a_mujoco_warning_exits_1(monkeypatch, capsys):
     assert "mjWARN_BADQACC" in capsys.readouterr().out
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_noise_seed_changes_the_result(tmp_path):
     a = run_json(tmp_path, "--seed", "1")
     b = run_json(tmp_path, "--seed", "2")
@@ -162,6 +163,7 @@ def test_demo_writes_results_and_summary(tmp_path):
     assert not list(out.glob("*.png"))  # --no-plots
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_without_switches_off_as_built_effects_by_name(tmp_path):
     full = run_json(tmp_path, "--plant", "as-built", "--seed", "0")
     ablated = run_json(tmp_path, "--plant", "as-built", "--seed", "0", "--without", "stiction,dead_zone")

@@ -146,6 +146,7 @@ def test_cells_of_picks_the_runs_of_the_wanted_seeds():
     assert twice.rmse_deg == (4.0,) and twice.failed == 1  # a seed asked for twice is one run
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_same_seeds_same_fit_whatever_the_workers(monkeypatch):
     small = dict(max_evaluations=2, fit_seeds=(0, 1, 2), check_seeds=(0,), ensemble_seeds=(1,))
     def no_new_runs(*args):
@@ -165,6 +166,7 @@ def test_same_seeds_same_fit_whatever_the_workers(monkeypatch):
     assert [c.rmse_deg for c in one.ensemble_cells] == [c.rmse_deg[1:] for c in alone]
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluations (the fixed starting simplex) cost
     exactly what the committed file says. The whole fit (100 evaluations, about 8 min on 2 cores) is

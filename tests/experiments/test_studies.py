@@ -16,8 +16,8 @@ import numpy as np
 import pytest
 
 from controllers.open_loop import ReversingSine
-from twin.experiments.studies import ablation, openloop, robustness
 from twin.experiments.calibrate import CELLS, Evaluator
+from twin.experiments.studies import ablation, openloop, robustness
 from twin.experiments.studies.openloop import Reversal, paired_reversals, reversal_lags
 from twin.plants import PLANTS
 from twin.plants.as_built import EFFECTS, calibrated_values
@@ -278,6 +278,7 @@ def test_ablation_switches_each_effect_off_once_and_the_line_with_the_chambers()
     assert found == {f"- {e}": ((e, "supply_line") if e == "compressibility" else (e,)) for e in EFFECTS}
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_cli_ablation_writes_every_variant_and_cell(tmp_path):
     proc = twin(tmp_path, "study", "ablation", "--seeds", "1", "--workers", "2", "--out", "ab")
     assert proc.returncode == 0, proc.stderr

@@ -44,6 +44,7 @@ def _lift_by_hand(pressure: float) -> float:
     return float(mass.min())
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_static_lift_limit_matches_the_torque_balance():
     study = lift_study(pressures_kpa=[500.0, 250.0], tolerance=0.004)  # unsorted on purpose
     assert [row["supply_kpa"] for row in study.rows] == [250.0, 500.0]
@@ -104,6 +105,7 @@ def test_pwm_study_varies_the_valves_only(monkeypatch):
     assert "Only the valves' PWM period varies" in study.answer
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_whatif_cli_writes_table_plot_and_answer(tmp_path):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     proc = subprocess.run([sys.executable, "-m", "twin", "whatif", "gear-load", "--out", "w"], cwd=tmp_path,

@@ -428,6 +428,7 @@ def test_default_substeps_match_a_fine_step_reference():
     assert rms_pa < 0.1e3 and rms_pb < 0.1e3
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 @pytest.mark.parametrize("controller", ["ffpva", "smc"])
 def test_closed_loop_tracking_is_converged_in_the_substeps(controller):
     """T3 (no stop at the end, where stick-slip makes T1's ending sensitive to anything): the default

@@ -110,6 +110,7 @@ def quaternion_turn(a: np.ndarray, b: np.ndarray) -> float:
     return math.degrees(2.0 * math.acos(min(1.0, abs(float(np.dot(a, b))))))
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_recording_plays_offline_and_moves_by_the_trace(tmp_path, page):
     html, trace = tmp_path / "out.html", tmp_path / "out.csv"
     proc = subprocess.run(
@@ -173,6 +174,7 @@ def wait_until(page, condition, timeout: float = 180.0, what: str = "") -> dict:
     raise AssertionError(f"timed out waiting for {what}; last readout {readout(page)}")
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_live_page_follows_the_slider_and_refuses_bad_messages(live_twin, page):
     proc, url, port = live_twin
     assert listening_addresses(port) == {"127.0.0.1"}

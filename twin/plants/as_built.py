@@ -38,6 +38,7 @@ as-built values are assumptions, stated in :data:`ASSUMED`.
 from __future__ import annotations
 
 import dataclasses
+import importlib.resources
 import json
 import pathlib
 from collections.abc import Iterable
@@ -49,7 +50,7 @@ from twin.plants.preset import THESIS_PARAMS, Plant
 
 EFFECTS = ("compressibility", "supply_line", "stiction", "ccw_friction", "dead_zone", "held_supply",
            "hall_calibration", "experiment_gains", "sensor_metrics")
-CALIBRATION_FILE = pathlib.Path(__file__).with_name("data") / "as_built.json"
+CALIBRATION_FILE = importlib.resources.files("twin.plants") / "data" / "as_built.json"  # package data
 
 
 @dataclasses.dataclass(frozen=True)
