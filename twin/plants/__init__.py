@@ -53,6 +53,10 @@ class PlantRegistry(MutableMapping):
                 raise InvalidScenario(f"no {name} plant: {error}") from None
         return self._plants[name]
 
+    def __contains__(self, name: object) -> bool:
+        """Listed: loaded, or a lazy preset whose source is there (not loaded by asking)."""
+        return name in self._plants or (name in self._lazy and self._lazy[name][0]())
+
     def __iter__(self) -> Iterator[str]:
         yield from self._plants
         yield from (name for name, (present, _) in self._lazy.items() if name not in self._plants and present())
@@ -64,7 +68,7 @@ class PlantRegistry(MutableMapping):
         self._plants[name] = preset
 
     def __delitem__(self, name: str) -> None:
-        if name not in self:
+        if name not in self._plants and name not in self._lazy:
             raise KeyError(name)
         self._plants.pop(name, None)
         self._lazy.pop(name, None)

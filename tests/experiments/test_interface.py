@@ -1,0 +1,82 @@
+"""One experiment interface: every what-if and study is driven the same way by the CLI, and a new
+one is a registered object, nothing else."""
+
+from __future__ import annotations
+
+import argparse
+import pathlib
+
+import pytest
+
+from twin.cli import main
+from twin.exceptions import InvalidScenario
+from twin.experiments.base import Experiment, Outcome
+from twin.experiments.studies import STUDIES
+from twin.experiments.whatifs import WHATIFS
+
+
+@pytest.mark.parametrize("name,experiment", [*WHATIFS.items(), *STUDIES.items()])
+def test_every_registered_experiment_implements_the_interface(name, experiment):
+    assert isinstance(experiment, Experiment)
+    assert experiment.name == name and experiment.help
+    for method in ("run", "plot"):
+        assert getattr(type(experiment), method) is not getattr(Experiment, method), f"{name} lacks {method}"
+
+
+@pytest.mark.parametrize("command,registry", [("whatif", WHATIFS), ("study", STUDIES)])
+def test_the_cli_offers_exactly_the_registered_experiments(command, registry, capsys):
+    with pytest.raises(SystemExit):
+        main([command, "--help"])
+    shown = capsys.readouterr().out
+    for name in registry:
+        assert name in shown
+
+
+class Recorder(Experiment):
+    """A what-if that records the order the CLI drives it in."""
+
+    name = "recorder"
+    help = "records calls"
+
+    def __init__(self, *, fail_check: bool = False, failed_runs: int = 0):
+        self.calls: list[str] = []
+        self.fail_check, self.failed_runs = fail_check, failed_runs
+
+    def add_arguments(self, parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--level", type=float, default=1.0)
+
+    def check(self, args: argparse.Namespace) -> None:
+        self.calls.append("check")
+        if self.fail_check:
+            raise InvalidScenario("--level is out of range")
+
+    def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
+        self.calls.append("run")
+        assert out.is_dir()
+        return Outcome(rows=[{"level": args.level, "answer": 42}], answer="forty-two", failed=self.failed_runs)
+
+    def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
+        self.calls.append("plot")
+        path.write_bytes(b"png")
+
+
+def test_a_new_whatif_is_one_registered_object(tmp_path, monkeypatch, capsys):
+    recorder = Recorder()
+    monkeypatch.setitem(WHATIFS, "recorder", recorder)
+    assert main(["whatif", "recorder", "--level", "2.5", "--out", str(tmp_path / "r")]) == 0
+    assert recorder.calls == ["check", "run", "plot"]
+    assert (tmp_path / "r" / "recorder.csv").read_text().splitlines() == ["level,answer", "2.5,42"]
+    assert (tmp_path / "r" / "recorder.txt").read_text() == "forty-two\n"
+    assert (tmp_path / "r" / "recorder.png").read_bytes() == b"png"
+    out = capsys.readouterr().out
+    assert out.startswith("forty-two\nwrote ")
+
+
+def test_bad_input_writes_nothing_and_a_failed_run_exits_1(tmp_path, monkeypatch, capsys):
+    monkeypatch.setitem(WHATIFS, "recorder", Recorder(fail_check=True))
+    assert main(["whatif", "recorder", "--out", str(tmp_path / "never")]) == 2
+    assert not (tmp_path / "never").exists()
+    assert capsys.readouterr().err.strip() == "twin: error: --level is out of range"
+    monkeypatch.setitem(WHATIFS, "recorder", Recorder(failed_runs=1))
+    assert main(["whatif", "recorder", "--out", str(tmp_path / "some")]) == 1
+    assert (tmp_path / "some" / "recorder.csv").exists()
