@@ -5,11 +5,11 @@
     while not timestep.last():
         timestep = env.step([duty_percent])
 
-The physics is the twin's own compiled model, and every physics step runs one
-twin tick through :class:`twin.sim.plant_state.PlantState`, the same sensors,
-observer, valves, hydraulics and friction as ``twin run`` (no second
-implementation). Per tick: actuate with the held duty, step MuJoCo, sample the
-sensors for the next tick.
+The physics is the twin's own compiled model, and every physics step is one
+tick of :class:`twin.sim.tick.Ticker`, the step order ``twin run`` uses, with
+the same sensors, observer, valves, hydraulics and friction (no second
+implementation); the agent's held action is the command. The observation
+reads the tick's measurement, which the tick then acts on.
 
 Tasks
     ``track``: follow T1-T4 (``trajectory=1..4``) or, with ``trajectory=None``,
@@ -55,6 +55,7 @@ from twin.physics.ticks import whole_ticks
 from twin.physics.trajectories import Reference, Segment, Trajectory, trajectory
 from twin.sim.plant_state import PlantState, place_on_manifold, true_start
 from twin.sim.scenario import Scenario
+from twin.sim.tick import Ticker
 
 TASKS = ("track", "hold")
 PREVIEW = 5  # future desired-angle samples, one PWM period apart
@@ -96,25 +97,32 @@ class JointPhysics(dm_mujoco.Physics):
         self.data.qvel[:] = 0.0
         self.plant = PlantState(scenarios=[s], joints=[self.joint], lengths=[ticks + 1],
                                 initial_position=y0, tick=preset.timestep)
-        self.k = 0
+        d = self.data
+        # dm_control's step: mj_step2 then mj_step1, so derived fields (gravity) are at the new state.
+        self.ticker = Ticker(self.plant, qpos=d.qpos[None, :], qvel=d.qvel[None, :], ctrl=d.ctrl[None, :],
+                             qfrc_passive=d.qfrc_passive[None, :], qfrc_bias=d.qfrc_bias[None, :],
+                             rack_dof=self.joint.rack_a_dof, step=lambda k: super(JointPhysics, self).step(1))
         self.duty = np.zeros(1)
-        self.measurement = self.plant.sense(0, y0)
+        self.ticker.sense()
         self.true_angle = np.zeros(ticks + 1)
         self.true_angle[0] = self.data.qpos[self.joint.spur_dof]
 
+    @property
+    def k(self) -> int:
+        """Ticks since the episode began."""
+        return self.ticker.k
+
+    @property
+    def measurement(self):
+        """The sensors and observer now (sampled once per tick; the next tick acts on it)."""
+        return self.ticker.sense()
+
     def step(self, nstep: int = 1) -> None:
-        dof = self.joint.rack_a_dof
         for _ in range(nstep):
             if self.k >= self.ticks:
                 raise InvalidScenario("the episode is over: reset the environment")
-            y, v = self.data.qpos[dof:dof + 1].copy(), self.data.qvel[dof:dof + 1].copy()
-            external = self.plant.external_force(self.data.qfrc_passive[None, :], self.data.qfrc_bias[None, :])
-            force_a, force_b = self.plant.actuate(self.k, self.duty, y, v, external)
-            self.data.ctrl[:] = (force_a[0], force_b[0])
-            super().step(1)  # mj_step2 then mj_step1: derived fields (gravity) at the new state
-            self.k += 1
+            self.ticker.act(self.duty)
             self.true_angle[self.k] = self.data.qpos[self.joint.spur_dof]
-            self.measurement = self.plant.sense(self.k, self.data.qpos[dof:dof + 1].copy())
 
     def ticks_for(self, duration: float) -> int:
         """Ticks in an episode of ``duration`` (s): whole action periods, rounded up."""

@@ -1,9 +1,9 @@
 """One scenario stepped on demand, with its target changed while it runs
 (``twin view``).
 
-The step order is :func:`twin.sim.simulation.simulate`'s: sensors, controller (at
-its period), valves and hydraulics (:class:`twin.sim.plant_state.PlantState`),
-physics. Only the reference differs: instead of a fixed trajectory it is a
+The step order is :class:`twin.sim.tick.Ticker`'s, as in ``twin run``: sensors,
+controller (at its period), valves and hydraulics, physics. Only the reference
+differs: instead of a fixed trajectory it is a
 *plan* that the user replaces while the joint moves:
 
 * a target angle: a cycloidal move (eq. 5.2.5) from the current desired angle,
@@ -31,6 +31,7 @@ from twin.physics.trajectories import Segment, Trajectory, trajectory
 from twin.sim.control import Setpoint
 from twin.sim.plant_state import PlantState, place_on_manifold, true_start
 from twin.sim.scenario import Scenario
+from twin.sim.tick import Ticker
 
 MOVE_RATE = math.radians(120.0)  # rad/s, average speed of a target move: T1's 120 deg in 1 s
 MIN_MOVE = 0.3  # s
@@ -77,9 +78,12 @@ class LiveJoint:
         mujoco.mj_forward(self.model, self.data)
         self.plant = PlantState(scenarios=[scenario], joints=[self.joint], lengths=[NOISE_BLOCK],
                                 initial_position=y0, tick=self.tick)
-        self.block, self.k, self.steps = 0, 0, 0
+        d = self.data
+        self.ticker = Ticker(self.plant, qpos=d.qpos[None, :], qvel=d.qvel[None, :], ctrl=d.ctrl[None, :],
+                             qfrc_passive=d.qfrc_passive[None, :], qfrc_bias=d.qfrc_bias[None, :],
+                             rack_dof=self.joint.rack_a_dof, step=self._physics_step)
+        self.block, self.steps = 0, 0
         self.duty = np.zeros(1)
-        self.dof = self.joint.rack_a_dof
 
     def switch_controller(self, name: str) -> None:
         """Drive the joint with controller ``name`` from the next tick on (a fresh controller state)."""
@@ -118,6 +122,11 @@ class LiveJoint:
     def _replan(self, plan: Trajectory) -> None:
         self.plan, self.plan_start = plan, self.time
 
+    @property
+    def k(self) -> int:
+        """Ticks into the current noise block."""
+        return self.ticker.k
+
     def _next_noise_block(self) -> None:
         self.block += 1
         rng = np.random.default_rng([self.scenario.seed, self.block])
@@ -125,26 +134,25 @@ class LiveJoint:
         if self.scenario.noise:
             self.plant.position_noise[0] = uniform_noise(rng, sensors.position_noise, (NOISE_BLOCK,))
             self.plant.pressure_noise[0] = uniform_noise(rng, sensors.pressure_noise, (NOISE_BLOCK, 3))
-        self.k = 0
+        self.ticker.restart(0)
 
-    def step(self) -> None:
-        """One tick, in :func:`twin.sim.simulation.simulate`'s order."""
-        if self.k == NOISE_BLOCK:
-            self._next_noise_block()
-        d = self.data
-        y, v = d.qpos[self.dof:self.dof + 1].copy(), d.qvel[self.dof:self.dof + 1].copy()
-        measurement = self.plant.sense(self.k, y)
-        if self.k % self.every == 0:
+    def _physics_step(self, k: int) -> None:
+        mujoco.mj_step2(self.model, self.data)  # then mj_step1: derived fields (gravity) at the new state
+        mujoco.mj_step1(self.model, self.data)
+
+    def _command(self, k: int, measurement) -> np.ndarray:
+        if k % self.every == 0:
             position, velocity, acceleration = self.desired()
             setpoint = Setpoint(position=np.array([position]), velocity=np.array([velocity]),
                                 acceleration=np.array([acceleration]))
             self.duty = self.controller.update(self.time, measurement, setpoint)
-        external = self.plant.external_force(d.qfrc_passive[None, :], d.qfrc_bias[None, :])
-        force_a, force_b = self.plant.actuate(self.k, self.duty, y, v, external)
-        d.ctrl[:] = (force_a[0], force_b[0])
-        mujoco.mj_step2(self.model, d)  # then mj_step1: derived fields (gravity) at the new state
-        mujoco.mj_step1(self.model, d)
-        self.k += 1
+        return self.duty
+
+    def step(self) -> None:
+        """One tick of :class:`twin.sim.tick.Ticker`."""
+        if self.k == NOISE_BLOCK:
+            self._next_noise_block()
+        self.ticker.tick(self._command)
         self.steps += 1
 
     def advance(self, duration: float) -> None:

@@ -1,5 +1,5 @@
 """The plant side of n scenarios between MuJoCo steps: one implementation for
-every loop that drives the joint (``twin.sim.simulation`` and ``twin.envs.environment``).
+every loop that drives the joint, called in the step order of :class:`twin.sim.tick.Ticker`.
 
 Per tick k, given the true rack state from MuJoCo:
 

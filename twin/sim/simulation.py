@@ -1,17 +1,10 @@
-"""The simulation loop: many scenarios stepped together, one step order.
+"""The simulation loop: many scenarios stepped together, in the one step order of
+:class:`twin.sim.tick.Ticker` (sensors, observer, controllers if due, valves,
+hydraulics, MuJoCo step), on ``mujoco.batch.Batch``.
 
-Every 1 ms tick k (t = k h, integer ticks, never a float clock), for all n
-scenarios at once (arrays have a leading scenario axis)::
-
-    MuJoCo state ──► sensors ──► observer ──► controllers ──► valves ──► hydraulics ──► mj_step
-       (qpos)       (Hall y,     (v_hat,      (if due: every   (delays,   (implicit rack   (Batch,
-                     pressures,   a_hat)       16 ms; SMC's     dead zone, step, friction,   all sims)
-                     noise)                    switching 1 ms)  PWM)       forces on racks)
-
-The physics step equals the sensor tick. The hydraulic callback runs in this
-loop, not as a process-global ``mjcb_control``, so two twins in one process
-cannot interfere; it writes only ``ctrl``. Scenarios with different payloads
-or orientations run on their own compiled models in the same batch.
+The physics step equals the sensor tick. Scenarios with different payloads or
+orientations run on their own compiled models in the same batch; a scenario
+that ends early stops being stepped.
 """
 
 from __future__ import annotations
@@ -36,6 +29,7 @@ from twin.sim.control import Controller, Setpoint
 from twin.sim.metrics import Metrics, tracking_metrics
 from twin.sim.plant_state import PlantState, groups, place_on_manifold, true_start
 from twin.sim.scenario import Scenario
+from twin.sim.tick import Ticker
 
 PROGRESS_EVERY = 250  # ticks between progress callbacks
 
@@ -145,23 +139,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     rec = {name: np.zeros((ticks, n)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps", "fs", "fa", "fb")}
     valve_open = np.zeros((ticks, n, 4), dtype=bool)
     stage_vel = int(mujoco.mjtStage.mjSTAGE_VEL)
-    for k in range(ticks):
-        y = qpos[:, dof.rack_a_dof].copy()
-        v = qvel[:, dof.rack_a_dof].copy()
-        measurement = plant.sense(k, y)
-        for controller, idx, every in controller_groups:
-            if k % every == 0:
-                setpoint = Setpoint(position=y_d[idx, k], velocity=v_d[idx, k], acceleration=a_d[idx, k])
-                duty[idx] = controller.update(k * h, measurement.subset(idx), setpoint)
-        ctrl[:, 0], ctrl[:, 1] = plant.actuate(k, duty, y, v, plant.external_force(qfrc_passive, qfrc_bias))
-        rec["y"][k] = y
-        rec["ym"][k] = measurement.position
-        rec["theta"][k] = qpos[:, dof.spur_dof]
-        rec["duty"][k] = duty
-        rec["pa"][k] = plant.pressure_a
-        rec["pb"][k] = plant.pressure_b
-        rec["ps"][k] = plant.supply_now
-        valve_open[k] = plant.conductance > 0
+    def step(k: int) -> None:
+        nonlocal active
         if k + 1 in ends:
             active = active[lengths[active] > k + 1]
         try:  # derived fields (gravity) at the new state; a finished scenario stops here
@@ -170,6 +149,26 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
             for i in error.ids:
                 failures[int(i)] = f"MuJoCo error at t = {k * h:.3f} s: {batch.error(int(i))}"
             active = np.array([i for i in active if int(i) not in failures], dtype=int)
+
+    def command(k: int, measurement) -> np.ndarray:
+        for controller, idx, every in controller_groups:
+            if k % every == 0:
+                setpoint = Setpoint(position=y_d[idx, k], velocity=v_d[idx, k], acceleration=a_d[idx, k])
+                duty[idx] = controller.update(k * h, measurement.subset(idx), setpoint)
+        return duty
+
+    ticker = Ticker(plant, qpos=qpos, qvel=qvel, ctrl=ctrl, qfrc_passive=qfrc_passive, qfrc_bias=qfrc_bias,
+                    rack_dof=dof.rack_a_dof, step=step)
+    for k in range(ticks):
+        rec["theta"][k] = qpos[:, dof.spur_dof]  # before the step, like y
+        ticker.tick(command)
+        rec["y"][k] = ticker.position
+        rec["ym"][k] = ticker.measurement.position  # what tick k sensed
+        rec["duty"][k] = duty
+        rec["pa"][k] = plant.pressure_a
+        rec["pb"][k] = plant.pressure_b
+        rec["ps"][k] = plant.supply_now
+        valve_open[k] = plant.conductance > 0
         # Constraint forces of this step (computed at tick k's state; not refreshed by the stage above).
         rec["fs"][k] = np.abs(qfrc_constraint[:, dof.spur_dof]) / spur_radius
         rec["fa"][k] = np.abs(qfrc_constraint[:, dof.rack_a_dof])
