@@ -50,7 +50,7 @@ from dm_control.suite import base  # noqa: E402
 from dm_env import specs  # noqa: E402
 
 from twin.exceptions import InvalidScenario
-from twin.physics.model import Orientation, build_mjcf, compile_joint
+from twin.physics.model import THESIS_PAYLOADS, Orientation, build_mjcf, compile_joint
 from twin.physics.ticks import whole_ticks
 from twin.physics.trajectories import Reference, Segment, Trajectory, trajectory
 from twin.sim.plant_state import PlantState, place_on_manifold, true_start
@@ -62,7 +62,7 @@ PREVIEW = 5  # future desired-angle samples, one PWM period apart
 HOLD_DURATION = 2.0  # s
 RANDOM_TRACK_DURATION = 4.0  # s
 RANDOM_RANGE = (math.radians(30.0), math.radians(160.0))  # rad, inside the friction fit
-MAX_RANDOM_PAYLOAD = 13.5e-3  # kg
+MAX_RANDOM_PAYLOAD = max(THESIS_PAYLOADS)  # kg
 
 
 @dataclasses.dataclass(frozen=True)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from twin.physics.model import THESIS_PAYLOADS
+
 # Simulated RMSE per trajectory T1..T4 and SSE of T1 (§8, "Simulation").
 THESIS_SIMULATED_RMSE_DEG = {
     "ffpva": {1: 0.52, 2: 0.83, 3: 0.91, 4: 0.80},
@@ -19,5 +21,5 @@ THESIS_EXPERIMENT_RMSE_DEG = {
 # Experiment T1 steady-state error range (+-, deg) over the 5 runs (§8).
 THESIS_EXPERIMENT_SSE_T1_RANGE_DEG = {"pva": 0.41, "ffpva": 0.77, "smc": 0.85}
 
-# The robustness study's tip payloads (§9), g.
-THESIS_PAYLOADS_G = (0.0, 6.5, 13.5)
+# The robustness study's tip payloads (§9), g: none, then the thesis's two.
+THESIS_PAYLOADS_G = (0.0, *(round(m * 1e3, 9) for m in THESIS_PAYLOADS))

@@ -33,6 +33,7 @@ MODEL_PATH = importlib.resources.files("models") / "joint.xml"  # package data o
 
 MECHANISM_JOINTS = ("rack_a", "rack_b", "pinion", "spur")
 MAX_PAYLOAD = 0.2  # kg; far past what 700 kPa can lift, a guard against unit mistakes
+THESIS_PAYLOADS = (6.5e-3, 13.5e-3)  # kg at the link tip: the thesis's two payloads (SPEC §2, §9)
 
 
 class Orientation(enum.Enum):
