@@ -84,7 +84,10 @@ for plant_name in ("thesis", "as-built"):
     j.set_target(1.0)
     j.advance(0.7)
     rs.append(j.readout())
-    j.switch_controller("ffpva"); j.play(3); j.advance(1.3); rs.append(j.readout())
+    j.switch_controller("ffpva")
+    j.play(3)
+    j.advance(1.3)
+    rs.append(j.readout())
     out[f"live {plant_name}"] = h([[r.time, r.angle, r.desired_angle, r.duty, r.pressure_a, r.pressure_b, r.supply_pressure, *r.valve_open] for r in rs])
 
 json.dump(out, open(sys.argv[1], "w"), indent=1, sort_keys=True)
