@@ -145,6 +145,40 @@ class ValveParams:
 
 
 @dataclasses.dataclass(frozen=True)
+class SolenoidParams:
+    """The solenoid valve's coil and plunger (:mod:`twin.physics.solenoid`), dimensionless where the
+    thesis gives nothing to scale by. The thesis gives none of these: they are fitted
+    (``python -m twin.experiments.valve_fit``) so that the valve test replica (§4.4.3, SPEC §3) gives
+    eq. 4.4.2's R(d), the 5 ms opening and 2 ms closing delays, and no flow from a 25 % pulse."""
+
+    coil_time_constant_on: float = 3.401e-3  # s, L / R while the coil is driven
+    coil_time_constant_off: float = 1.768e-3  # s, current decay after switch-off (through the suppressor)
+    force_ratio: float = 8.838  # f_m: magnetic force at full current with the valve open (smallest gap), over the spring preload
+    gap_ratio: float = 1.071  # kappa: magnetic gap with the valve shut over the gap left when open, minus 1
+    spring_ratio: float = 0.6866  # k: spring force gained over the full travel, over its preload
+    natural_frequency: float = 10380.0  # rad/s, w = sqrt(preload / (plunger mass x travel))
+    damping_ratio: float = 1.576  # zeta, of the plunger in water
+    step: float = 5e-6  # s, integration step (converged: halving it changes R(d) by < 1 %, a test checks)
+
+    def __post_init__(self) -> None:
+        _require_positive(self, "coil_time_constant_on", "coil_time_constant_off", "natural_frequency",
+                          "damping_ratio", "step")
+        if self.force_ratio <= 1.0:
+            raise InvalidParameter(f"force_ratio must exceed 1 (the coil must lift the plunger), got {self.force_ratio}")
+        if self.gap_ratio < 0 or self.spring_ratio < 0:
+            raise InvalidParameter("gap_ratio and spring_ratio must be non-negative")
+
+
+@dataclasses.dataclass(frozen=True)
+class ValveTestRigParams:
+    """The valve test of §4.4.3: one valve between a set pressure and atmosphere, PWM at 16 ms."""
+
+    pressure_drops: tuple[float, ...] = (100e3, 200e3, 300e3, 400e3, 500e3)  # Pa (*inferred*: the text's range)
+    inertance_time: float = 1.417e-3  # s, tau_I = I / R(100 %) of the rig's water column (fitted with SolenoidParams)
+    min_measurable_flow: float = 1e-6  # m^3/s, below it the thesis could not measure flow (§3)
+
+
+@dataclasses.dataclass(frozen=True)
 class FrictionParams:
     """Force loss F_l = F_c(y) sgn(v) + F_v v (eqs. 4.5.5 and 4.5.7)."""
 

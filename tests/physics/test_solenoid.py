@@ -1,0 +1,95 @@
+"""The solenoid valve against closed forms, and its replica of the thesis's valve test (§4.4.3)."""
+
+from __future__ import annotations
+
+import csv
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from twin.cli import main
+from twin.experiments.studies import valve
+from twin.physics import solenoid
+from twin.physics.params import NOMINAL_PARAMS, SolenoidParams, ValveTestRigParams
+
+P = SolenoidParams()
+RIG = ValveTestRigParams()
+H = P.step
+
+
+def test_coil_current_rises_and_decays_exponentially():
+    ticks = 2000
+    on, _ = solenoid.simulate(P, np.ones(ticks), h=H)
+    t = np.arange(1, ticks + 1) * H
+    assert np.allclose(on[:, 0], 1 - np.exp(-t / P.coil_time_constant_on), atol=1e-12)
+    off, _ = solenoid.simulate(P, np.zeros(ticks), h=H, state=np.array([1.0, 1.0, 0.0, 1.0]))
+    assert np.allclose(off[:, 0], np.exp(-t / P.coil_time_constant_off), atol=1e-12)
+
+
+def test_the_plunger_moves_once_the_magnetic_force_beats_the_preload():
+    """Pull-in: f_m i^2 / (1 + kappa)^2 = 1 with i = 1 - exp(-t / tau_on)."""
+    pull_in = -P.coil_time_constant_on * math.log(1 - (1 + P.gap_ratio) / math.sqrt(P.force_ratio))
+    states, _ = solenoid.simulate(P, np.ones(3000), h=H)
+    first_lift = (np.flatnonzero(states[:, 1] > 0)[0] + 1) * H
+    assert first_lift == pytest.approx(pull_in, abs=2 * H)
+
+
+def test_held_open_it_passes_the_open_valve_flow_after_the_column_accelerates():
+    """tau_I dq/dt = 1 - q with the valve open: q = 1 - exp(-t / tau_I) (implicit Euler, within 0.5 %)."""
+    ticks = 3000
+    states, _ = solenoid.simulate(P, np.ones(ticks), h=H, inertance_time=RIG.inertance_time,
+                                  state=np.array([1.0, 1.0, 0.0, 0.0]))
+    t = np.arange(1, ticks + 1) * H
+    assert np.allclose(states[:, 3], 1 - np.exp(-t / RIG.inertance_time), atol=5e-3)
+    assert states[-1, 3] == pytest.approx(1.0, abs=1e-4)  # 10 time constants in
+
+
+def test_shut_it_passes_nothing_and_coil_off_keeps_it_shut():
+    states, _ = solenoid.simulate(P, np.zeros(5000), h=H, inertance_time=RIG.inertance_time)
+    assert not states[:, 1:].any()
+
+
+def test_a_full_pulse_gives_the_thesis_delays_within_1_ms():
+    opening, closing = solenoid.delays(P, h=H)
+    assert abs(opening - 5e-3) <= 1e-3 and abs(closing - 2e-3) <= 1e-3
+
+
+def test_a_pulse_under_the_dead_zone_lifts_nothing_and_passes_no_flow():
+    ticks = int(round(NOMINAL_PARAMS.valves.pwm_period / H))
+    states, _ = solenoid.simulate(P, solenoid.coil_command(25.0, ticks), h=H, periods=5,
+                                  inertance_time=RIG.inertance_time)
+    assert states[:, 1].max() == 0.0 and states[:, 3].max() == 0.0
+    assert 25.0 < valve.emergent_dead_zone() <= 30.0
+
+
+def test_the_replica_follows_eq_4_4_2_within_15_percent_from_35_to_100_percent():
+    outcome = valve.valve_study()
+    ratios = {r["duty_pct"]: r["resistance_twin_pa_s_per_m3"] / r["resistance_eq442_pa_s_per_m3"]
+              for r in outcome.rows}
+    assert [d for d, x in ratios.items() if d >= 35 and abs(x - 1) > 0.15] == []
+    assert ratios[100.0] == pytest.approx(1.0, rel=1e-9)  # the open valve: by construction
+
+
+def test_the_replica_is_converged_in_the_integration_step():
+    halved = dataclasses.replace(P, step=P.step / 2)
+    for duty in (35.0, 50.0, 80.0, 95.0):
+        coarse, fine = (solenoid.mean_flow_fraction(p, duty, period=16e-3, h=p.step, inertance_time=RIG.inertance_time)
+                        for p in (P, halved))
+        assert fine == pytest.approx(coarse, rel=0.01)
+
+
+def test_flow_is_proportional_to_the_pressure_drop():
+    resistance, intercept, flows = valve.replica(60.0)
+    drops = np.array(RIG.pressure_drops)
+    assert np.allclose(flows, drops / resistance, rtol=1e-9) and abs(intercept) < 1e-15
+
+
+def test_cli_writes_the_valve_table_and_plot(tmp_path):
+    assert main(["study", "valve", "--out", str(tmp_path / "v")]) == 0
+    with open(tmp_path / "v" / "valve.csv") as handle:
+        rows = list(csv.DictReader(handle))
+    assert list(rows[0]) == ["duty_pct", "resistance_eq442_pa_s_per_m3", "resistance_twin_pa_s_per_m3"]
+    assert [float(r["duty_pct"]) for r in rows] == list(range(30, 101, 5))
+    assert (tmp_path / "v" / "valve.png").read_bytes()[:4] == b"\x89PNG"
