@@ -170,7 +170,7 @@ def test_same_seeds_same_fit_whatever_the_workers(monkeypatch):
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluations (the fixed starting simplex) cost
     exactly what the committed file says. The whole fit (100 evaluations, about 8 min on 2 cores) is
-    ``twin calibrate --out DIR``; its file equals the committed one (see README, as-built)."""
+    ``twin calibrate --out DIR``; its file equals the committed one (see docs/as-built.md)."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, max_evaluations=3, check_seeds=(), ensemble_seeds=())
     for (values, cost_now), expected in zip(result.history, committed["history"][:3], strict=True):

@@ -1,7 +1,7 @@
 """The thesis's simulated results (SPEC §8) against the 'thesis' plant, mean over seeds 0-4.
 
 Nothing in the twin is tuned to these numbers; this checks how close the twin
-lands and records where it does not (see README, "Reproduction").
+lands and records where it does not (see docs/reproduction.md).
 """
 
 from __future__ import annotations

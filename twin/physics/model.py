@@ -90,7 +90,7 @@ def build_mjcf(*, params: JointParams = NOMINAL_PARAMS, payload_mass: float = 0.
     with importlib.resources.as_file(MODEL_PATH) as path:
         root = _mjcf().from_path(str(path))
     root.option.timestep = timestep
-    # solref below 2 x timestep is clamped by MuJoCo (FINDINGS): use the stiffest allowed.
+    # solref below 2 x timestep is clamped by MuJoCo (a smaller one diverged when tried): use the stiffest allowed.
     root.default.equality.solref = (2.0 * timestep, 1.0)
 
     masses, gears = params.masses, params.gears

@@ -1,8 +1,7 @@
 """Every physical parameter of the joint, in SI units, with its source.
 
-Sections (§) refer to ``shared/SPEC.md``; equation numbers are the thesis's.
-Conversions to mm, degrees, grams and kPa happen only in ``twin/units.py``
-callers at the user-facing edge.
+Sections (§) refer to ``docs/model.md`` (cited as "SPEC §N"); equation numbers are the thesis's.
+Conversions to mm, degrees, grams and kPa happen only at the user-facing edge (CLI, tables, plots).
 """
 
 from __future__ import annotations

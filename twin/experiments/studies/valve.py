@@ -69,13 +69,18 @@ def valve_study(params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigPara
     checked = [r for r in rows if r["duty_pct"] >= CHECKED_FROM]
     ratios = [r["resistance_twin_pa_s_per_m3"] / r["resistance_eq442_pa_s_per_m3"] for r in checked]
     worst = max(range(len(checked)), key=lambda j: abs(ratios[j] - 1))
+    fine = [d for d in range(int(CHECKED_FROM), 101)
+            if abs(replica(float(d), params=params, rig=rig)[0] / valves.resistance(float(d)) - 1) > TOLERANCE]
     opening, closing = solenoid.delays(params, h=params.step)
     within = sum(abs(x - 1) <= TOLERANCE for x in ratios)
     answer = (f"Valve test replica (§4.4.3), PWM {valves.pwm_period * 1e3:g} ms, pressure drops "
               f"{', '.join(f'{d / 1e3:g}' for d in rig.pressure_drops)} kPa: the twin's R(d) is within "
               f"{TOLERANCE:.0%} of eq. 4.4.2 at {within} of {len(checked)} duties from {CHECKED_FROM:g} % to 100 % "
               f"(twin / eq. 4.4.2 from {min(ratios):.2f} to {max(ratios):.2f}; furthest at "
-              f"{checked[worst]['duty_pct']:g} %). R(100 %) is the open valve's resistance by construction. "
+              f"{checked[worst]['duty_pct']:g} %). Between those steps, at 1 % steps, "
+              + (f"{len(fine)} duties are outside {TOLERANCE:.0%} ({fine[0]}-{fine[-1]} %: off-times too short for the "
+                 "valve to shut, so it stays open). " if fine else "none is outside it. ")
+              + "R(100 %) is the open valve's resistance by construction. "
               f"Full pulse: opens {opening * 1e3:.1f} ms after the coil switches on, shuts {closing * 1e3:.1f} ms after "
               f"it switches off (thesis: 5 and 2 ms). Dead zone: no flow below {emergent_dead_zone(params, rig):g} % "
               f"(thesis: about 30 %). Flow is proportional to the pressure drop (largest intercept "
