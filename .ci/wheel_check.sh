@@ -10,9 +10,9 @@ python3 -m venv "$work/build-venv"
 "$work/build-venv/bin/python" -m build --wheel --outdir "$work/dist" . >/dev/null
 wheel=$(ls "$work"/dist/*.whl)
 echo "wheel: $(basename "$wheel")"
+listing=$(python3 -m zipfile -l "$wheel")
 for needed in models/joint.xml twin/plants/data/as_built.json viz/live_page.html viz/recording_page.html; do
-  python3 -m zipfile -l "$wheel" | grep -q "^$needed " \
-    || { echo "wheel check: $needed is missing from the wheel" >&2; exit 1; }
+  grep -q "^$needed " <<<"$listing" || { echo "wheel check: $needed is missing from the wheel" >&2; exit 1; }
 done
 python3 -m venv "$work/venv"
 "$work/venv/bin/pip" install -q "$wheel"
