@@ -93,3 +93,47 @@ def test_cli_writes_the_valve_table_and_plot(tmp_path):
     assert list(rows[0]) == ["duty_pct", "resistance_eq442_pa_s_per_m3", "resistance_twin_pa_s_per_m3"]
     assert [float(r["duty_pct"]) for r in rows] == list(range(30, 101, 5))
     assert (tmp_path / "v" / "valve.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def _bank(n: int = 1):
+    from twin.physics.params import ValveParams
+    from twin.physics.valves import ValveBank, ValveModel
+
+    return ValveBank(params=ValveParams(dead_zone_duty=0.0), model=ValveModel.SOLENOID, n=n, tick=1e-3)
+
+
+def test_in_the_plant_a_pulse_under_the_dead_zone_never_opens_the_drain():
+    bank = _bank()
+    drains = [bank.update(k, np.array([20.0]))[0, 3] for k in range(160)]  # 20 %: 3.2 ms pulses, ten periods
+    assert max(drains) == 0.0
+    bank.reset()
+    supply = [bank.update(k, np.array([20.0]))[0, 0] for k in range(160)]
+    assert supply[-1] == pytest.approx(bank.full_conductance)  # the pair's supply valve is held on
+
+
+def test_in_the_plant_a_full_command_opens_after_the_opening_delay():
+    bank = _bank()
+    drain = np.array([bank.update(k, np.array([100.0]))[0, 3] for k in range(12)]) / bank.full_conductance
+    assert drain[3] == 0.0 and drain[5] > 0.0 and drain[6] == pytest.approx(1.0)  # 5 ms, as the replica's
+    assert all(bank.update(k, np.array([100.0]))[0, [1, 2]].max() == 0.0 for k in range(12, 20))  # V2, V3 shut
+
+
+def test_the_drain_coil_follows_the_duty_in_force_inside_the_period():
+    """Sliding mode's 1 ms updates: the discharge coil is on while the period's elapsed ticks are below
+    the duty now in force (the thesis's hardware)."""
+    from twin.physics.valves import _solenoid_coils
+
+    coil = np.zeros((1, 4))
+    on = []
+    for k, duty in enumerate([50.0] * 4 + [10.0] * 4 + [90.0] * 8):  # one 16 ms period
+        _solenoid_coils(np.array([duty]), k, 16, 16, coil)
+        on.append(coil[0, 3])
+    assert on == [1.0] * 4 + [0.0] * 4 + [1.0] * 6 + [0.0] * 2
+
+
+def test_the_solenoid_preset_runs_without_warnings():
+    from twin.envs.runner import run
+    from twin.sim.scenario import Scenario
+
+    result = run(Scenario("smc", 1, plant="thesis-solenoid"))
+    assert not result.warnings and math.degrees(result.metrics.rmse) < 10.0

@@ -104,46 +104,6 @@ class MassParams:
 
 
 @dataclasses.dataclass(frozen=True)
-class ValveParams:
-    """On/off solenoid valves, pulse-width-modulated (§3) and eq. 4.4.2."""
-
-    pwm_period: float = 16e-3  # s, 62.5 Hz
-    switching_period: float = 1e-3  # s, the DAQ's output tick (§5, §6): duties realised in whole ticks; 0 = continuous
-    opening_delay: float = 5e-3  # s
-    closing_delay: float = 2e-3  # s
-    dead_zone_duty: float = 30.0  # %, below it the real valve does not open
-    # §3: only the discharge valve is pulse-width-modulated, the pair's supply valve "stays fully on". True: it
-    # stays on while the discharge valve gets no pulse that opens it (|u| in the dead zone, or below half a 1 ms
-    # step); False: the pair is shut together, the thesis's model. An incompressible joint hardly moves
-    # differently (no flow either way; the held valve only squeezes the locked train: <= 4e-4 deg).
-    supply_held_in_dead_zone: bool = False
-    resistance_coefficient: float = 1.8372e14  # Pa s/m^3 at d = 1 % (eq. 4.4.2, *resolution*: Pa s/m^3)
-    resistance_exponent: float = -2.1706  # eq. 4.4.2
-
-    def __post_init__(self) -> None:
-        _require_positive(self, "pwm_period", "resistance_coefficient")
-        if self.opening_delay < 0 or self.closing_delay < 0:
-            raise InvalidParameter("valve delays must be non-negative")
-        if self.switching_period < 0 or self.switching_period > self.pwm_period:
-            raise InvalidParameter(f"switching_period must be in [0, pwm_period], got {self.switching_period}")
-        if not 0.0 <= self.dead_zone_duty < 100.0:
-            raise InvalidParameter(f"dead_zone_duty must be in [0, 100) %, got {self.dead_zone_duty}")
-
-    def resistance(self, duty_percent):
-        """R(d) = 1.8372e14 d^-2.1706 Pa s/m^3 (eq. 4.4.2); d in %, d > 0."""
-        return self.resistance_coefficient * duty_percent ** self.resistance_exponent
-
-    def duty_for_resistance(self, resistance):
-        """Inverse of eq. 4.4.2: d = (R / 1.8372e14)^(1 / -2.1706) % (eq. 5.3.3)."""
-        return (resistance / self.resistance_coefficient) ** (1.0 / self.resistance_exponent)
-
-    @property
-    def open_resistance(self) -> float:
-        """R1: a valve fully on, R(100 %) = 8.36e9 Pa s/m^3 (§4)."""
-        return float(self.resistance(100.0))
-
-
-@dataclasses.dataclass(frozen=True)
 class SolenoidParams:
     """The solenoid valve's coil and plunger (:mod:`twin.physics.solenoid`), dimensionless where the
     thesis gives nothing to scale by. The thesis gives none of these: they are fitted
@@ -166,6 +126,48 @@ class SolenoidParams:
             raise InvalidParameter(f"force_ratio must exceed 1 (the coil must lift the plunger), got {self.force_ratio}")
         if self.gap_ratio < 0 or self.spring_ratio < 0:
             raise InvalidParameter("gap_ratio and spring_ratio must be non-negative")
+
+
+@dataclasses.dataclass(frozen=True)
+class ValveParams:
+    """On/off solenoid valves, pulse-width-modulated (§3) and eq. 4.4.2."""
+
+    pwm_period: float = 16e-3  # s, 62.5 Hz
+    switching_period: float = 1e-3  # s, the DAQ's output tick (§5, §6): duties realised in whole ticks; 0 = continuous
+    opening_delay: float = 5e-3  # s
+    closing_delay: float = 2e-3  # s
+    dead_zone_duty: float = 30.0  # %, below it the real valve does not open
+    # §3: only the discharge valve is pulse-width-modulated, the pair's supply valve "stays fully on". True: it
+    # stays on while the discharge valve gets no pulse that opens it (|u| in the dead zone, or below half a 1 ms
+    # step); False: the pair is shut together, the thesis's model. An incompressible joint hardly moves
+    # differently (no flow either way; the held valve only squeezes the locked train: <= 4e-4 deg).
+    supply_held_in_dead_zone: bool = False
+    resistance_coefficient: float = 1.8372e14  # Pa s/m^3 at d = 1 % (eq. 4.4.2, *resolution*: Pa s/m^3)
+    resistance_exponent: float = -2.1706  # eq. 4.4.2
+    # The solenoid valve's coil and plunger, for the ``solenoid`` valve model (the others ignore it).
+    solenoid: SolenoidParams = dataclasses.field(default_factory=SolenoidParams)
+
+    def __post_init__(self) -> None:
+        _require_positive(self, "pwm_period", "resistance_coefficient")
+        if self.opening_delay < 0 or self.closing_delay < 0:
+            raise InvalidParameter("valve delays must be non-negative")
+        if self.switching_period < 0 or self.switching_period > self.pwm_period:
+            raise InvalidParameter(f"switching_period must be in [0, pwm_period], got {self.switching_period}")
+        if not 0.0 <= self.dead_zone_duty < 100.0:
+            raise InvalidParameter(f"dead_zone_duty must be in [0, 100) %, got {self.dead_zone_duty}")
+
+    def resistance(self, duty_percent):
+        """R(d) = 1.8372e14 d^-2.1706 Pa s/m^3 (eq. 4.4.2); d in %, d > 0."""
+        return self.resistance_coefficient * duty_percent ** self.resistance_exponent
+
+    def duty_for_resistance(self, resistance):
+        """Inverse of eq. 4.4.2: d = (R / 1.8372e14)^(1 / -2.1706) % (eq. 5.3.3)."""
+        return (resistance / self.resistance_coefficient) ** (1.0 / self.resistance_exponent)
+
+    @property
+    def open_resistance(self) -> float:
+        """R1: a valve fully on, R(100 %) = 8.36e9 Pa s/m^3 (§4)."""
+        return float(self.resistance(100.0))
 
 
 @dataclasses.dataclass(frozen=True)

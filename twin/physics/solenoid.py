@@ -105,3 +105,32 @@ def _run(coil, periods, h, tau_on, tau_off, force_ratio, gap_ratio, spring_ratio
     state_out = np.empty(4)
     state_out[0], state_out[1], state_out[2], state_out[3] = i, x, v, q
     return state_out
+
+
+@numba.njit(cache=True)
+def tick_openings(coil, substeps, h, tau_on, tau_off, force_ratio, gap_ratio, spring_ratio, omega, zeta, state,
+                  opening):  # pragma: no cover - compiled
+    """Every valve through one control tick of ``substeps`` steps of ``h`` with its coil ``coil`` (n, 4)
+    held; ``state`` (n, 4, 3) = (i, x, v) in place; ``opening`` (n, 4) = the tick's mean lift x (its
+    mean opening area, a fraction of full). The plant's own inertia stands in for the water column."""
+    rise, fall = 1.0 - math.exp(-h / tau_on), 1.0 - math.exp(-h / tau_off)
+    for a in range(coil.shape[0]):
+        for b in range(coil.shape[1]):
+            s = coil[a, b]
+            i, x, v = state[a, b, 0], state[a, b, 1], state[a, b, 2]
+            total = 0.0
+            for _ in range(substeps):
+                i += (s - i) * (rise if s > i else fall)
+                gap = 1.0 + gap_ratio * (1.0 - x)
+                force = force_ratio * i * i / (gap * gap) - (1.0 + spring_ratio * x)
+                v += h * (omega * omega * force - 2.0 * zeta * omega * v)
+                x += h * v
+                if x <= 0.0:
+                    x = 0.0
+                    v = max(v, 0.0) if force > 0.0 else 0.0
+                elif x >= 1.0:
+                    x = 1.0
+                    v = min(v, 0.0) if force < 0.0 else 0.0
+                total += x
+            state[a, b, 0], state[a, b, 1], state[a, b, 2] = i, x, v
+            opening[a, b] = total / substeps

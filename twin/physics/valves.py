@@ -22,7 +22,16 @@ continuous (a sensitivity variant).
     coil is on for the first |u| x period of each period. A pulse shorter than
     ``dead_zone_duty`` x period is not sent: the real valve does not open (§3).
 
-In both, while the discharge valve gets no pulse (|u| below the dead zone, or
+``solenoid`` (physical, :mod:`twin.physics.solenoid`)
+    The coils get the same signals as ``pwm`` (the discharge coil on while the
+    period's elapsed time is below the duty in force, so a controller updating
+    every 1 ms acts inside the period; the pair's supply coil on while any duty
+    is commanded), but no delay or dead zone is imposed: each valve's coil
+    current and plunger are integrated through the tick, and its conductance is
+    R(100 %)^-1 times the tick's mean opening. ``dead_zone_duty`` and the delays
+    are not used; they come out of the physics.
+
+In ``averaged`` and ``pwm``, while the discharge valve gets no pulse (|u| below the dead zone, or
 under half a switching step), the pair's supply valve shuts with it, or stays
 on if ``supply_held_in_dead_zone`` (§3: the supply valve of the pair "stays
 fully on"; only a compressible plant moves differently).
@@ -44,6 +53,7 @@ import numba
 import numpy as np
 
 from twin.exceptions import InvalidScenario
+from twin.physics import solenoid
 from twin.physics.params import ValveParams
 from twin.physics.scenario_axis import per_scenario
 from twin.physics.ticks import whole_ticks
@@ -54,6 +64,7 @@ SUPPLY_A, DRAIN_A, SUPPLY_B, DRAIN_B = range(4)  # V1, V2, V3, V4
 class ValveModel(enum.Enum):
     AVERAGED = "averaged"
     PWM = "pwm"
+    SOLENOID = "solenoid"
 
 
 class ValveBank:
@@ -76,16 +87,20 @@ class ValveBank:
         if params.switching_period > 0:
             self.duty_steps = whole_ticks(params.pwm_period, params.switching_period, what="PWM period")
             whole_ticks(params.switching_period, tick, what="valve switching period")
-        elif model is ValveModel.PWM:
-            raise InvalidScenario("the time-resolved PWM valve needs a switching period")
+        elif model in (ValveModel.PWM, ValveModel.SOLENOID):
+            raise InvalidScenario(f"the {model.value} valve needs a switching period")
         else:
             self.duty_steps = 0  # continuous duty
+        self.tick = tick
+        self.substeps = max(1, round(tick / params.solenoid.step))
+        self._plunger = np.zeros((n, 4, 3))  # solenoid model: coil current, lift, lift speed of each valve
         self._on_run = np.zeros((n, 4), dtype=np.int64)  # ticks the coil has been on, this one included
         self._off_run = np.full((n, 4), 1 << 30, dtype=np.int64)
         self._open = np.zeros((n, 4), dtype=bool)
         self._conductance = np.zeros((n, 4))
 
     def reset(self) -> None:
+        self._plunger[:] = 0.0
         self._on_run[:] = 0
         self._off_run[:] = 1 << 30
         self._open[:] = False
@@ -96,6 +111,14 @@ class ValveBank:
         p = self.params
         out = np.empty((self.n, 4))
         duty = per_scenario(duty, self.n)  # read unchecked when compiled
+        if self.model is ValveModel.SOLENOID:
+            s = p.solenoid
+            coil = np.empty((self.n, 4))
+            _solenoid_coils(duty, int(tick), self.duty_steps, self.period_ticks, coil)
+            solenoid.tick_openings(coil, self.substeps, self.tick / self.substeps, s.coil_time_constant_on,
+                                   s.coil_time_constant_off, s.force_ratio, s.gap_ratio, s.spring_ratio,
+                                   s.natural_frequency, s.damping_ratio, self._plunger, out)
+            return out * self.full_conductance
         _valve_tick(duty, int(tick), self.duty_steps, self.period_ticks, self.model is ValveModel.AVERAGED,
                     float(p.dead_zone_duty), bool(p.supply_held_in_dead_zone),
                     float(p.resistance_coefficient), float(p.resistance_exponent),
@@ -139,3 +162,20 @@ def _valve_tick(duty, tick, duty_steps, period_ticks, averaged, dead_zone, hold_
             if on:
                 conductance[i, j] = coil[j]
             out[i, j] = conductance[i, j] if is_open[i, j] else 0.0
+
+
+@numba.njit(cache=True)
+def _solenoid_coils(duty, tick, duty_steps, period_ticks, coil):  # pragma: no cover - compiled
+    """Coil signals (n, 4) of the solenoid model: V1..V4, 1.0 on. The pair's supply coil is on while
+    the realised duty is not zero; its discharge coil while the period's elapsed ticks are below the
+    duty in force."""
+    for i in range(duty.shape[0]):
+        magnitude = min(abs(duty[i]), 100.0)
+        on = np.rint(magnitude / 100.0 * duty_steps) * (100.0 / duty_steps) > 0.0
+        in_pulse = on and (tick % period_ticks) < np.rint(magnitude / 100.0 * period_ticks)
+        supply = 1.0 if on else 0.0
+        drain = 1.0 if in_pulse else 0.0
+        coil[i, 0] = supply if duty[i] > 0 else 0.0
+        coil[i, 1] = drain if duty[i] < 0 else 0.0
+        coil[i, 2] = supply if duty[i] < 0 else 0.0
+        coil[i, 3] = drain if duty[i] > 0 else 0.0

@@ -31,4 +31,6 @@ THESIS_PLANTS = {
         THESIS_PARAMS, valves=ValveParams(dead_zone_duty=0.0, switching_period=0.0)), ValveModel.AVERAGED, "simulation"),
     "thesis-pwm": Plant("thesis-pwm", dataclasses.replace(THESIS_PARAMS, valves=ValveParams()),
                         ValveModel.PWM, "simulation"),
+    "thesis-solenoid": Plant("thesis-solenoid", dataclasses.replace(THESIS_PARAMS, valves=ValveParams(dead_zone_duty=0.0)),
+                             ValveModel.SOLENOID, "simulation"),
 }
