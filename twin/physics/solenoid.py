@@ -76,6 +76,23 @@ def mean_flow_fraction(params: SolenoidParams, duty: float, *, period: float, h:
     return float(states[:, 3].mean())
 
 
+@numba.njit(cache=True, inline="always")
+def _step(s, i, x, v, h, rise, fall, force_ratio, gap_ratio, spring_ratio, omega, zeta):  # pragma: no cover
+    """One step of coil and plunger (the module docstring's equations); returns (i, x, v)."""
+    i += (s - i) * (rise if s > i else fall)
+    gap = 1.0 + gap_ratio * (1.0 - x)
+    force = force_ratio * i * i / (gap * gap) - (1.0 + spring_ratio * x)
+    v += h * (omega * omega * force - 2.0 * zeta * omega * v)
+    x += h * v
+    if x <= 0.0:
+        x = 0.0
+        v = max(v, 0.0) if force > 0.0 else 0.0
+    elif x >= 1.0:
+        x = 1.0
+        v = min(v, 0.0) if force < 0.0 else 0.0
+    return i, x, v
+
+
 @numba.njit(cache=True)
 def _run(coil, periods, h, tau_on, tau_off, force_ratio, gap_ratio, spring_ratio, omega, zeta, tau_i, state,
          out):  # pragma: no cover - compiled
@@ -83,18 +100,7 @@ def _run(coil, periods, h, tau_on, tau_off, force_ratio, gap_ratio, spring_ratio
     rise, fall = 1.0 - math.exp(-h / tau_on), 1.0 - math.exp(-h / tau_off)
     for _ in range(periods):
         for k in range(coil.shape[0]):
-            s = coil[k]
-            i += (s - i) * (rise if s > i else fall)
-            gap = 1.0 + gap_ratio * (1.0 - x)
-            force = force_ratio * i * i / (gap * gap) - (1.0 + spring_ratio * x)
-            v += h * (omega * omega * force - 2.0 * zeta * omega * v)
-            x += h * v
-            if x <= 0.0:
-                x = 0.0
-                v = max(v, 0.0) if force > 0.0 else 0.0
-            elif x >= 1.0:
-                x = 1.0
-                v = min(v, 0.0) if force < 0.0 else 0.0
+            i, x, v = _step(coil[k], i, x, v, h, rise, fall, force_ratio, gap_ratio, spring_ratio, omega, zeta)
             if x <= 0.0:
                 q = 0.0
             elif tau_i > 0.0:
@@ -120,17 +126,7 @@ def tick_openings(coil, substeps, h, tau_on, tau_off, force_ratio, gap_ratio, sp
             i, x, v = state[a, b, 0], state[a, b, 1], state[a, b, 2]
             total = 0.0
             for _ in range(substeps):
-                i += (s - i) * (rise if s > i else fall)
-                gap = 1.0 + gap_ratio * (1.0 - x)
-                force = force_ratio * i * i / (gap * gap) - (1.0 + spring_ratio * x)
-                v += h * (omega * omega * force - 2.0 * zeta * omega * v)
-                x += h * v
-                if x <= 0.0:
-                    x = 0.0
-                    v = max(v, 0.0) if force > 0.0 else 0.0
-                elif x >= 1.0:
-                    x = 1.0
-                    v = min(v, 0.0) if force < 0.0 else 0.0
+                i, x, v = _step(s, i, x, v, h, rise, fall, force_ratio, gap_ratio, spring_ratio, omega, zeta)
                 total += x
             state[a, b, 0], state[a, b, 1], state[a, b, 2] = i, x, v
             opening[a, b] = total / substeps
