@@ -19,3 +19,7 @@ class InvalidController(TwinError, ValueError):
 
 class SimulationFailed(TwinError, RuntimeError):
     """MuJoCo raised an error or the state diverged."""
+
+
+class InvalidAction(TwinError, ValueError):
+    """An environment was given an action it cannot apply (not a finite number)."""

@@ -24,6 +24,7 @@ from twin.sim.scenario import Scenario
 AXES = ("controller", "trajectory", "payload", "orientation", "plant", "seed", "supply_kpa", "pwm_period_ms")
 DEFAULTS = {"controller": ["ffpva"], "trajectory": [1], "payload": [0.0], "orientation": ["horizontal"],
             "plant": ["thesis"], "seed": [0], "supply_kpa": [None], "pwm_period_ms": [None]}
+MAX_POINTS = 100_000  # scenarios in one sweep (about 3 days of 4 s runs on 2 cores)
 NUMERIC = {"payload": float, "supply_kpa": float, "pwm_period_ms": float, "trajectory": int, "seed": int}
 
 
@@ -43,14 +44,21 @@ def _number(text: str, kind: type) -> int | float:
     return float(text) + 0.0  # + 0.0 turns -0.0 into 0.0: one value, one key
 
 
-def _range(text: str, kind: type) -> list:
+def _range(text: str, kind: type, flag: str) -> list:
     parts = text.split(":")
     if len(parts) != 3:
-        raise InvalidScenario(f"a range is start:stop:step, got {text!r}")
+        raise InvalidScenario(f"bad range {text!r} for {flag}: a range is start:stop:step")
     start, stop, step = (float(p) for p in parts)
-    if step <= 0 or stop < start:
-        raise InvalidScenario(f"a range needs step > 0 and stop >= start, got {text!r}")
+    if not all(math.isfinite(x) for x in (start, stop, step)):
+        raise InvalidScenario(f"bad range {text!r} for {flag}: start, stop and step must be finite")
+    if step <= 0:
+        raise InvalidScenario(f"bad range {text!r} for {flag}: step must be positive")
+    if stop < start:
+        raise InvalidScenario(f"bad range {text!r} for {flag}: stop before start")
     count = int(math.floor((stop - start) / step + 1e-9)) + 1
+    if count > MAX_POINTS:
+        raise InvalidScenario(f"range {text!r} for {flag} has {count:,} values: more than the {MAX_POINTS:,} "
+                              "scenarios a sweep takes")
     values = [round(start + i * step, 12) + 0.0 for i in range(count)]
     return [_whole(v) for v in values] if kind is int else values
 
@@ -64,14 +72,22 @@ def parse_axis(name: str, value) -> list:
     out: list = []
     for item in items:
         text = str(item).strip()
+        flag = f"--{name.replace('_', '-')}"
         try:
             if kind is not str and ":" in text:
-                out += _range(text, kind)
+                out += _range(text, kind, flag)
             elif name == "seed" and "-" in text.lstrip("-"):
                 low, high = (int(x) for x in text.split("-"))
+                if high < low:
+                    raise InvalidScenario(f"bad range {text!r} for {flag}: stop before start")
+                if high - low + 1 > MAX_POINTS:
+                    raise InvalidScenario(f"range {text!r} for {flag} has {high - low + 1:,} values: more than "
+                                          f"the {MAX_POINTS:,} scenarios a sweep takes")
                 out += list(range(low, high + 1))
             else:
                 out.append(kind(text) if kind is str else _number(text, kind))
+        except InvalidScenario:
+            raise
         except ValueError:
             expected = {int: ": expected whole numbers", float: ": expected numbers"}.get(kind, "")
             raise InvalidScenario(f"bad value {text!r} for --{name.replace('_', '-')}{expected}") from None
@@ -92,6 +108,8 @@ def read_toml(path) -> dict[str, list]:
     table = data.get("grid", data)
     if not isinstance(table, dict):
         raise InvalidScenario(f"--config {str(path)!r}: [grid] must be a table of axes")
+    if not table:
+        raise InvalidScenario(f"--config {str(path)!r} names no axes: give at least one, e.g. seed = [0, 1, 2]")
     return {key.replace("-", "_"): parse_axis(key.replace("-", "_"), value) for key, value in table.items()}
 
 
@@ -139,8 +157,17 @@ def _without_plant_defaults(point: GridPoint) -> GridPoint:
     )
 
 
+def grid_size(axes: dict[str, list]) -> int:
+    """Scenarios the axes span before duplicates are merged (defaults count once)."""
+    return math.prod(len(values) for values in {**DEFAULTS, **axes}.values())
+
+
 def expand(axes: dict[str, list]) -> list[GridPoint]:
-    """Every distinct combination, in a fixed order; each checked by building its Scenario."""
+    """Every distinct combination, in a fixed order; each checked by building its Scenario. A grid of
+    more than MAX_POINTS scenarios is refused before any is built."""
+    size = grid_size(axes)
+    if size > MAX_POINTS:
+        raise InvalidScenario(f"the grid has {size:,} scenarios: more than the {MAX_POINTS:,} a sweep takes")
     merged = {**DEFAULTS, **axes}
     points = (GridPoint(*combo) for combo in itertools.product(*(merged[a] for a in AXES)))
     return list(dict.fromkeys(_without_plant_defaults(p) for p in points))  # scenario() names a bad value

@@ -23,14 +23,21 @@ class StaleStore(TwinError):
     """A results store written by another version of the code or parameters."""
 
 
+class StoreUnwritable(TwinError):
+    """The results store cannot be created or written where asked."""
+
+
 class ResultStore:
     def __init__(self, path: pathlib.Path, *, version: str):
         self.path = path
-        self._db = sqlite3.connect(path)
-        self._db.execute("PRAGMA journal_mode=WAL")
-        with self._db:
-            self._db.execute(f"CREATE TABLE IF NOT EXISTS results ({', '.join(COLUMNS)}, PRIMARY KEY (key))")
-            self._db.execute("CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT)")
+        try:
+            self._db = sqlite3.connect(path)
+            self._db.execute("PRAGMA journal_mode=WAL")
+            with self._db:
+                self._db.execute(f"CREATE TABLE IF NOT EXISTS results ({', '.join(COLUMNS)}, PRIMARY KEY (key))")
+                self._db.execute("CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT)")
+        except sqlite3.Error as error:  # a folder that exists but cannot be written, a full disk, a broken file
+            raise StoreUnwritable(f"cannot write the results store {path}: {error}") from None
         try:
             self._claim(version)
         except StaleStore:

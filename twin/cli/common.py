@@ -3,6 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
+import pathlib
+import sys
 
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
@@ -59,3 +63,26 @@ def scenario_from(args: argparse.Namespace) -> Scenario:
         orientation=Orientation(args.orientation), plant=plant_of(args), seed=args.seed, noise=args.noise,
         supply_pressure=None if args.supply_kpa is None else args.supply_kpa * 1e3,
     )
+
+
+@contextlib.contextmanager
+def all_or_nothing(paths: list[pathlib.Path]):
+    """Temporary files beside ``paths`` (same folder, same suffix) to write into; each becomes its path
+    only once every one was written, and none is left behind if any write fails."""
+    temporary = [path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}") for path in paths]
+    try:
+        yield temporary
+        for tmp, path in zip(temporary, paths, strict=True):
+            os.replace(tmp, path)
+    except OSError as error:  # name the file the user asked for, not its temporary
+        named = {str(tmp): str(path) for tmp, path in zip(temporary, paths, strict=True)}
+        raise OSError(error.errno, error.strerror, named.get(str(error.filename), error.filename)) from None
+    finally:
+        for tmp in temporary:
+            tmp.unlink(missing_ok=True)
+
+
+def say_written(paths: list[pathlib.Path]) -> None:
+    """``wrote PATH`` for each, on stderr (stdout may be one JSON object)."""
+    for path in paths:
+        print(f"wrote {path}", file=sys.stderr)

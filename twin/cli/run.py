@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import json
 
-from twin.cli.common import add_scenario_arguments, scenario_from
+from twin.cli.common import add_scenario_arguments, all_or_nothing, say_written, scenario_from
 from twin.experiments import arguments
 
 
@@ -14,16 +14,20 @@ def _cmd_run(args: argparse.Namespace) -> int:
     from twin.sim import report
 
     result = run(scenario_from(args))
-    if args.trace:
-        report.write_trace(result, args.trace)
-    if args.plot:
-        from viz.plots import plot_run
+    outputs = [path for path in (args.trace, args.plot, args.html) if path is not None]
+    with all_or_nothing(outputs) as temporary:  # every output, or none (a failed one leaves no other)
+        staged = dict(zip(outputs, temporary, strict=True))
+        if args.trace:
+            report.write_trace(result, staged[args.trace])
+        if args.plot:
+            from viz.plots import plot_run
 
-        plot_run(result, args.plot)
-    if args.html:
-        from viz.recording import write_recording
+            plot_run(result, staged[args.plot])
+        if args.html:
+            from viz.recording import write_recording
 
-        write_recording(result, args.html)
+            write_recording(result, staged[args.html])
+    say_written(outputs)
     record = report.summary(result)
     if args.json:
         print(json.dumps(record))

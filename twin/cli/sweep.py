@@ -6,6 +6,7 @@ import argparse
 import pathlib
 import sys
 
+from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 
 
@@ -20,6 +21,8 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         value = getattr(args, name)
         if value is not None:
             axes[name] = grid.parse_axis(name, value)
+    if not axes:
+        raise InvalidScenario("the sweep names no axes: give at least one, e.g. --seed 0-4 (or --config GRID.toml)")
     points = grid.expand(axes)
     args.out.mkdir(exist_ok=True)
     open_store(args.out).close()  # refuses a store of another code version before any output

@@ -40,6 +40,7 @@ import collections
 import dataclasses
 import math
 import os
+import warnings
 
 os.environ.setdefault("MUJOCO_GL", "egl")  # dm_control picks a GL backend on import; the twin never renders here
 
@@ -49,7 +50,7 @@ from dm_control.rl import control  # noqa: E402
 from dm_control.suite import base  # noqa: E402
 from dm_env import specs  # noqa: E402
 
-from twin.exceptions import InvalidScenario
+from twin.exceptions import InvalidAction, InvalidScenario
 from twin.physics.model import THESIS_PAYLOADS, Orientation, build_mjcf, compile_joint
 from twin.physics.ticks import whole_ticks
 from twin.physics.trajectories import Reference, Segment, Trajectory, trajectory
@@ -212,12 +213,26 @@ class JointTask(base.Task):
 
     def initialize_episode(self, physics: JointPhysics) -> None:
         physics.begin(self.next_episode(), ticks=physics.ticks_for(self.duration))
+        self._clipped_said = False
 
     def action_spec(self, physics):
         return specs.BoundedArray(shape=(1,), dtype=np.float64, minimum=-100.0, maximum=100.0, name="duty")
 
     def before_step(self, action, physics: JointPhysics) -> None:
-        physics.duty = np.clip(np.asarray(action, dtype=float).reshape(1), -100.0, 100.0)
+        """The action is the duty in %: a non-finite one is refused (InvalidAction); one outside
+        [-100, 100] is clipped, and the first clip of an episode is reported (a warning)."""
+        try:
+            duty = np.asarray(action, dtype=float).reshape(1)
+        except (TypeError, ValueError):
+            raise InvalidAction(f"the action must be one number (duty in %), got {action!r}") from None
+        if not np.all(np.isfinite(duty)):
+            raise InvalidAction(f"the action must be a finite duty in %, got {float(duty[0])}")
+        clipped = np.clip(duty, -100.0, 100.0)
+        if clipped[0] != duty[0] and not getattr(self, "_clipped_said", False):
+            warnings.warn(f"action {duty[0]:g} % clipped to {clipped[0]:g} % (the duty is within ±100 %); "
+                          "further clips this episode are not reported", stacklevel=2)
+            self._clipped_said = True
+        physics.duty = clipped
 
     def get_observation(self, physics: JointPhysics) -> collections.OrderedDict:
         m = physics.measurement

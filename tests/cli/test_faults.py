@@ -1,0 +1,89 @@
+"""Bad input and unwritable outputs from the command line: a one-line error, exit 2, nothing written
+(issue: "Nothing half-written, nothing lost, no surprises"; the rows done so far)."""
+
+from __future__ import annotations
+
+import warnings
+
+import numpy as np
+import pytest
+
+from twin.cli import main
+from twin.exceptions import InvalidAction
+
+
+def _one_line_error(capsys, *needles: str) -> str:
+    err = capsys.readouterr().err.strip()
+    assert err.startswith("twin: error:") and len(err.splitlines()) == 1, err
+    for needle in needles:
+        assert needle in err, err
+    return err
+
+
+def test_run_writes_every_output_or_none(tmp_path, capsys):
+    """An output that cannot be written (a path under /proc: root can write anywhere else) leaves none."""
+    trace = tmp_path / "ok.csv"
+    assert main(["run", "--controller", "ffpva", "--trajectory", "1", "--trace", str(trace),
+                 "--plot", "/proc/x.png"]) == 2
+    _one_line_error(capsys, "/proc/x.png")
+    assert list(tmp_path.iterdir()) == []  # neither ok.csv nor a temporary
+
+
+def test_run_says_what_it_wrote(tmp_path, capsys):
+    trace, plot = tmp_path / "t.csv", tmp_path / "t.png"
+    assert main(["run", "--controller", "smc", "--trajectory", "1", "--trace", str(trace), "--plot", str(plot),
+                 "--json"]) == 0
+    out, err = capsys.readouterr()
+    assert out.count("\n") == 1 and out.startswith("{")  # still exactly one JSON object on stdout
+    assert err.splitlines() == [f"wrote {trace}", f"wrote {plot}"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["t.csv", "t.png"]
+
+
+def test_a_sweep_into_a_folder_it_cannot_write_is_one_line(capsys):
+    assert main(["sweep", "--seed", "0", "--out", "/proc/self"]) == 2
+    _one_line_error(capsys, "cannot write the results store")
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--payload", "10:0:1"], ["'10:0:1'", "--payload", "stop before start"]),
+    (["--seed", "4-0"], ["'4-0'", "--seed", "stop before start"]),
+    (["--payload", "0:1:0"], ["step must be positive"]),
+    (["--payload", "0:1000000:0.001"], ["1,000,000,001 values", "100,000"]),
+    (["--seed", "0-999", "--payload", "0:100:0.5"], ["201,000 scenarios", "100,000"]),
+    ([], ["names no axes"]),
+])
+def test_sweep_grids_are_checked_before_anything_runs(tmp_path, capsys, args, words):
+    out = tmp_path / "never"
+    assert main(["sweep", *args, "--out", str(out)]) == 2
+    _one_line_error(capsys, *words)
+    assert not out.exists()
+
+
+def test_an_empty_grid_file_is_an_error(tmp_path, capsys):
+    config = tmp_path / "grid.toml"
+    config.write_text("[grid]\n")
+    assert main(["sweep", "--config", str(config), "--out", str(tmp_path / "never")]) == 2
+    _one_line_error(capsys, "names no axes")
+    assert not (tmp_path / "never").exists()
+
+
+def test_environment_refuses_non_finite_actions_and_reports_a_clip_once():
+    from twin.envs import environment
+
+    env = environment.load("track", trajectory=1, seed=0)
+    env.reset()
+    for bad in (np.nan, np.inf, -np.inf):
+        with pytest.raises(InvalidAction, match="finite"):
+            env.step([bad])
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        env.step([1e9])
+        env.step([-1e9])
+    clipped = [w for w in caught if "clipped" in str(w.message)]
+    assert len(clipped) == 1 and "1e+09 % clipped to 100 %" in str(clipped[0].message)
+    assert env.physics.duty[0] == -100.0
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        env.reset()
+        env.step([500.0])
+    assert len([w for w in caught if "clipped" in str(w.message)]) == 1  # once per episode
