@@ -41,7 +41,7 @@ def test_run_says_what_it_wrote(tmp_path, capsys):
 
 def test_a_sweep_into_a_folder_it_cannot_write_is_one_line(capsys):
     assert main(["sweep", "--seed", "0", "--out", "/proc/self"]) == 2
-    _one_line_error(capsys, "cannot write the results store")
+    _one_line_error(capsys, "cannot write", "/proc/self")
 
 
 @pytest.mark.parametrize("args, words", [
@@ -87,3 +87,41 @@ def test_environment_refuses_non_finite_actions_and_reports_a_clip_once():
         env.reset()
         env.step([500.0])
     assert len([w for w in caught if "clipped" in str(w.message)]) == 1  # once per episode
+
+
+def test_a_results_store_that_cannot_be_created_is_a_one_line_error(tmp_path):
+    from twin.batch.store import ResultStore, StoreUnwritable
+
+    with pytest.raises(StoreUnwritable, match="cannot write the results store"):
+        ResultStore(tmp_path / "missing-folder" / "results.sqlite", version="v")
+
+
+def test_one_writer_per_output_folder(tmp_path, capsys):
+    """A second writer is refused at once, naming the first's PID; a dead holder's lock is taken over."""
+    import subprocess
+    import sys
+
+    from twin.batch.lock import LOCK_NAME, FolderBusy, folder_lock
+
+    out = tmp_path / "out"
+    out.mkdir()
+    holder = subprocess.Popen([sys.executable, "-c", (
+        "import pathlib, sys, time\n"
+        "from twin.batch.lock import folder_lock\n"
+        f"with folder_lock(pathlib.Path({str(out)!r})):\n"
+        "    print('locked', flush=True)\n"
+        "    time.sleep(60)\n")], stdout=subprocess.PIPE, text=True)
+    try:
+        assert holder.stdout.readline().strip() == "locked"
+        assert main(["sweep", "--seed", "0", "--out", str(out)]) == 2
+        _one_line_error(capsys, f"process {holder.pid}", "another --out")
+        assert main(["whatif", "gear-load", "--out", str(out)]) == 2
+        _one_line_error(capsys, f"process {holder.pid}")
+        assert sorted(p.name for p in out.iterdir()) == [LOCK_NAME]  # nothing else was written
+    finally:
+        holder.kill()  # SIGKILL: no clean-up runs
+        holder.wait()
+    with folder_lock(out):  # the dead holder's lock is taken over
+        with pytest.raises(FolderBusy):  # and held: a second taker in this process is refused too
+            with folder_lock(out):
+                pass

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from twin.batch.lock import folder_lock
 from twin.cli.common import Parser
 from twin.experiments import arguments
 from twin.experiments.base import Experiment
@@ -17,15 +18,16 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
     """Exit 0, or 1 when some run failed, or 130 when interrupted (a resumable one keeps its runs)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
     args.out.mkdir(exist_ok=True)
-    try:
-        outcome = experiment.run(args, args.out)
-    except KeyboardInterrupt:
-        if not experiment.resumable:
-            raise
-        print(f"interrupted: finished runs are kept in {args.out / 'results.sqlite'}; "
-              "run the same command again to finish the rest", file=sys.stderr)
-        return 130
-    paths = experiment.outputs(outcome, args.out)
+    with folder_lock(args.out):  # one writer per folder
+        try:
+            outcome = experiment.run(args, args.out)
+        except KeyboardInterrupt:
+            if not experiment.resumable:
+                raise
+            print(f"interrupted: finished runs are kept in {args.out / 'results.sqlite'}; "
+                  "run the same command again to finish the rest", file=sys.stderr)
+            return 130
+        paths = experiment.outputs(outcome, args.out)
     print(outcome.answer)
     print(f"wrote {', '.join(str(p) for p in paths)}")
     return 1 if outcome.failed else 0

@@ -6,15 +6,13 @@ import argparse
 import pathlib
 import sys
 
+from twin.batch.lock import folder_lock
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
-    from tqdm import tqdm
-
-    from twin.batch import grid, tables
-    from twin.batch.sweep import open_store, run_sweep
+    from twin.batch import grid
 
     axes = grid.read_toml(args.config) if args.config else {}
     for name in grid.AXES:
@@ -25,6 +23,16 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         raise InvalidScenario("the sweep names no axes: give at least one, e.g. --seed 0-4 (or --config GRID.toml)")
     points = grid.expand(axes)
     args.out.mkdir(exist_ok=True)
+    with folder_lock(args.out):  # one writer per folder: a second sweep into it is refused, naming this one
+        return _sweep(args, points)
+
+
+def _sweep(args: argparse.Namespace, points: list) -> int:
+    from tqdm import tqdm
+
+    from twin.batch import tables
+    from twin.batch.sweep import open_store, run_sweep
+
     open_store(args.out).close()  # refuses a store of another code version before any output
     print(f"{len(points)} scenarios -> {args.out.resolve()}", file=sys.stderr)
     bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
