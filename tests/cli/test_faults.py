@@ -125,3 +125,39 @@ def test_one_writer_per_output_folder(tmp_path, capsys):
         with pytest.raises(FolderBusy):  # and held: a second taker in this process is refused too
             with folder_lock(out):
                 pass
+
+
+def _exit_code(argv: list[str]) -> int:
+    """main's return value, or the code argparse exits with."""
+    try:
+        return main(argv)
+    except SystemExit as stop:
+        return stop.code
+
+
+@pytest.mark.parametrize("argv", [["run", "--controller", "x", "--trajectory", "1"],
+                                  ["whatif", "payload", "--seeds", "0", "--out", "x"],
+                                  ["study", "robustness", "--seeds", "0", "--out", "x"],
+                                  ["sweep", "--seed", "a", "--out", "x"], ["view", "--port", "-1"]])
+def test_every_command_errors_with_one_prefix(argv, capsys, tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert _exit_code(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("twin: error:") and len(err.strip().splitlines()) == 1, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_bench_names_each_stage_as_it_starts(monkeypatch):
+    """The measurements themselves are stubbed: only the progress reports are under test."""
+    from types import SimpleNamespace
+
+    from twin.experiments import bench
+
+    monkeypatch.setattr(bench, "run_many", lambda scenarios, **k: [SimpleNamespace(trace=SimpleNamespace(time=[0] * 3000))])
+    monkeypatch.setattr(bench, "_bare_step_cost", lambda seconds: 1.0)
+    monkeypatch.setattr(bench, "_fastest", lambda work, repeats: 1.0)
+    monkeypatch.setattr(bench, "_env_cost", lambda trajectory, duration: 1.0)
+    monkeypatch.setattr(bench, "_sweep_walls", lambda workers: ({1: 1.0}, 1.0))
+    stages: list[str] = []
+    bench.measure(batch_size=3, progress=stages.append)
+    assert [s.split("]")[0] for s in stages] == ["[1/4", "[2/4", "[3/4", "[4/4"]

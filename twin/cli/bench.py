@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import sys
 
 from twin.experiments import arguments
 
@@ -10,7 +11,10 @@ from twin.experiments import arguments
 def _cmd_bench(args: argparse.Namespace) -> int:
     from twin.experiments.bench import measure
 
-    for line in measure(batch_size=args.batch, workers=args.workers).lines():
+    def progress(stage: str) -> None:
+        print(f"bench: {stage} ...", file=sys.stderr, flush=True)
+
+    for line in measure(batch_size=args.batch, workers=args.workers, progress=progress).lines():
         print(line)
     return 0
 

@@ -19,8 +19,9 @@ EXIT_USAGE = 2
 
 
 class Parser(argparse.ArgumentParser):
-    def error(self, message: str) -> None:  # one line, no usage dump
-        self.exit(EXIT_USAGE, f"{self.prog}: error: {message}\n")
+    def error(self, message: str) -> None:  # one line, no usage dump, one prefix for every command
+        command = " ".join(self.prog.split()[1:])
+        self.exit(EXIT_USAGE, f"twin: error: {command + ': ' if command else ''}{message}\n")
 
 
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:

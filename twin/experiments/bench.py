@@ -95,20 +95,27 @@ def _sweep_walls(workers: int) -> tuple[dict, float]:
     return {count: _fastest(functools.partial(sweep, count), REPEATS) for count in sorted({1, workers})}, scenario_seconds
 
 
-def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None) -> Bench:
+def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None,
+            progress: Callable[[str], None] | None = None) -> Bench:
     """Each measurement is preceded and the whole followed by a bare loop; the bare cost is the fastest
-    of them all, so a quiet spell during one bare loop cannot flatter the twin."""
+    of them all, so a quiet spell during one bare loop cannot flatter the twin. ``progress(stage)``
+    names each of the four stages as it starts."""
+    say = progress or (lambda stage: None)
+    say("[1/4] one run and bare mj_step")
     scenario = Scenario("ffpva", trajectory)
     single = run_many([scenario])[0]  # also warms caches (model compile, imports, kernels)
     duration = float(len(single.trace.time)) * 1e-3
     bare = [_bare_step_cost(duration * 10)]
     twin_single = _fastest(lambda: run_many([scenario]), REPEATS) / duration
     bare.append(_bare_step_cost(duration * 10))
+    say(f"[2/4] a batch of {batch_size} runs")
     batch = [Scenario("ffpva", trajectory, seed=s) for s in range(batch_size)]
     twin_batch = _fastest(lambda: run_many(batch, nthread=1), REPEATS) / (duration * batch_size)  # one core, as the bare loop
     bare.append(_bare_step_cost(duration * 10))
+    say("[3/4] the dm_control environment")
     env_single = _env_cost(trajectory, duration)
     bare.append(_bare_step_cost(duration * 10))
+    say("[4/4] the sweep on 1 and all workers")
     walls, scenario_seconds = _sweep_walls(workers or os.cpu_count() or 1)
     bare.append(_bare_step_cost(duration * 10))
     return Bench(bare_step=min(bare), twin_single=twin_single, twin_batch=twin_batch, batch_size=batch_size,

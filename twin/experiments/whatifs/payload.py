@@ -63,6 +63,10 @@ class PayloadWhatIf(Experiment):
             return payload_study(out=store, payloads_g=args.payload_values, trajectory=args.trajectory,
                                  seeds=args.seeds, plant_name=args.plant, workers=args.workers, progress=bar.update)
 
+    def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
+        """``payload.csv`` and ``payload.txt``, and the sweep store the runs are kept in (resumable)."""
+        return super().write(outcome, out) + [out / "payload-runs"]
+
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         plot_summary(outcome.rows, path)
 
