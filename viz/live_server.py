@@ -49,7 +49,9 @@ from viz.scene import Frame, JointScene, frame_commands
 FRAME_RATE = 30.0  # pictures per second of wall time
 MIN_REBUILD_INTERVAL = 0.5  # s between model rebuilds (each compiles the model on the server's thread)
 MAX_LAG_FRAMES = 3.0  # a late picture catches up at most this many frames of simulated time
-MAX_MESSAGE_BYTES = 4096  # tornado refuses larger WebSocket messages before they are read
+# Tornado closes the socket on a larger WebSocket message without reading it; below this, an oversized
+# command (live_messages.MAX_MESSAGE_BYTES) is read and answered with an error, and the socket stays open.
+MAX_MESSAGE_BYTES = 64 * 1024
 LOOPBACK_HOSTS = ("127.0.0.1", "localhost", "::1")
 MAX_RECORDED_FRAMES = 10 * 60 * FPS  # a --html recording keeps the last 10 minutes
 PAGE = importlib.resources.files("viz") / "live_page.html"  # package data

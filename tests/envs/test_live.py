@@ -230,12 +230,15 @@ def test_server_checks_every_message_and_keeps_running():
     server = _ServerThread(Scenario("ffpva", 1, seed=0))
     try:
         url = f"ws://127.0.0.1:{server.viewer.port}/ws"
-        bad = ['{"type": "payload", "grams": 80}', "}{", '{"type": "target", "angle_deg": 500}']
+        bad = ['{"type": "payload", "grams": 80}', "}{",
+               '{"type": "target", "pad": "' + "x" * 5000 + '"}',  # over 4 KiB: it closed the socket once
+               '{"type": "target", "angle_deg": 500}']  # answered: the socket stayed open
         received = asyncio.run(_exchange(url, bad, wait=2.0))
     finally:
         server.stop()
     errors = [m["message"] for m in received if isinstance(m, dict) and m.get("type") == "error"]
     assert errors == ["payload: grams must be in [0, 50] g, got 80", "message is not JSON",
+                      "message too long (5029 bytes, at most 1024)",
                       "target: angle_deg must be in [0, 180] deg, got 500"]
     times = [m["time"] for m in received if isinstance(m, dict) and m.get("type") == "readout"]
     assert len(times) > 10 and times[-1] > times[0]  # the simulation went on

@@ -207,6 +207,15 @@ def test_live_page_follows_the_slider_and_refuses_bad_messages(live_twin, page):
     still = readout(page)["time"]
     wait_until(page, lambda r: r["time"] > still + 0.5, what="the simulation to keep running")
 
+    page.evaluate("window.twinSend({type: 'target', angle_deg: 90, note: 'x'.repeat(5000)})")  # over 4 KiB
+    assert page.evaluate("window.twinErrors").pop().startswith("not sent: message too long")
+    page.evaluate("window.twinSocket.close()")  # a dropped connection, the twin still running
+    page.wait_for_function("document.getElementById('state').textContent.startsWith('connection lost')",
+                           timeout=5_000)
+    page.wait_for_function("window.twinSocket.readyState === WebSocket.OPEN", timeout=15_000)
+    back = readout(page)["time"]
+    wait_until(page, lambda r: r["time"] > back + 0.5, what="readouts again after reconnecting")
+
     page.select_option("#orientation", "vertical")  # rebuild and restart
     page.wait_for_function("window.twinState.orientation === 'vertical'", timeout=30_000)
     wait_until(page, lambda r: r["time"] < 2.0, what="the restarted run")
