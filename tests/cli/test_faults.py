@@ -161,3 +161,45 @@ def test_bench_names_each_stage_as_it_starts(monkeypatch):
     stages: list[str] = []
     bench.measure(batch_size=3, progress=stages.append)
     assert [s.split("]")[0] for s in stages] == ["[1/4", "[2/4", "[3/4", "[4/4"]
+
+
+@pytest.mark.slow  # over ~2.5 s on 2 cores
+@pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM"])
+def test_an_interrupted_sweep_stops_at_once_keeps_what_finished_and_resumes(tmp_path, stop):
+    import signal
+    import sqlite3
+    import subprocess
+    import sys
+    import time
+
+    out = tmp_path / "sweep"
+    argv = [sys.executable, "-m", "twin", "sweep", "--controller", "ffpva,smc", "--trajectory", "1,3",
+            "--payload", "0:10:2", "--seed", "0-19", "--plant", "as-built", "--workers", "2", "--out", str(out)]
+    total = 2 * 2 * 6 * 20
+
+    def stored() -> int:
+        try:
+            with sqlite3.connect(out / "results.sqlite") as db:
+                return db.execute("SELECT COUNT(*) FROM results").fetchone()[0]
+        except sqlite3.Error:
+            return 0
+
+    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + 120
+    while stored() == 0 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    assert proc.poll() is None, "the sweep finished before it could be interrupted: make the grid larger"
+    sent = time.monotonic()
+    proc.send_signal(getattr(signal, stop))
+    _, err = proc.communicate(timeout=60)
+    assert time.monotonic() - sent < 2.0  # measured 0.4 s
+    assert proc.returncode == 130 and "interrupted: finished scenarios are kept" in err
+    kept = stored()
+    assert 0 < kept < total
+
+    again = subprocess.run(argv, capture_output=True, text=True, timeout=600)
+    assert again.returncode == 0, again.stderr
+    assert f"{total - kept} run, {kept} already done, 0 failed" in again.stdout
+    assert f"{total}/{total}" in again.stderr.replace("\r", "\n").splitlines()[-1] or f"{total}/{total}" in again.stderr
+    with sqlite3.connect(out / "results.sqlite") as db:
+        assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (total, total)

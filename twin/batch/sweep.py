@@ -24,6 +24,7 @@ import math
 import multiprocessing
 import os
 import pathlib
+import signal
 import tomllib
 from collections.abc import Callable, Sequence
 from concurrent.futures.process import BrokenProcessPool
@@ -108,7 +109,8 @@ def run_chunk(points: Sequence[GridPoint]) -> list[dict]:
         return [row for p in points for row in run_chunk([p])]
 
 
-MAX_CHUNK = 128  # scenarios per batch: bounds what a crash can lose
+MAX_CHUNK = 64  # scenarios per batch: bounds what an interrupt or a crash can lose (one batch per worker);
+# 2026-11-24, 880 as-built runs on 2 workers: 64 as fast as 128 (17.5-19.6 s against 20.2-21.1 s), 32 35 % slower
 
 
 def make_chunks(points: Sequence[GridPoint], workers: int) -> list[list[GridPoint]]:
@@ -144,14 +146,27 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
 
     compile_kernels()
     context = multiprocessing.get_context("fork")
-    with concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+    pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                                  initializer=_ignore_interrupts)
+    try:
         futures = [pool.submit(run_chunk, chunk) for chunk in chunks]
-        try:
-            for future in concurrent.futures.as_completed(futures):
-                on_done(future.result())
-        except BaseException:
-            pool.shutdown(wait=False, cancel_futures=True)
-            raise
+        for future in concurrent.futures.as_completed(futures):
+            on_done(future.result())
+    except BaseException:
+        # Ctrl-C, SIGTERM or an error: what finished is already stored; the chunks in flight are lost
+        # (at most one per worker), and the workers are stopped now rather than waited for.
+        processes = list((getattr(pool, "_processes", None) or {}).values())
+        pool.shutdown(wait=False, cancel_futures=True)
+        for process in processes:
+            process.kill()
+        raise
+    else:
+        pool.shutdown(wait=True)
+
+
+def _ignore_interrupts() -> None:
+    """In a worker: Ctrl-C is the parent's to handle (it stops the workers itself)."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
 
 
 def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
@@ -192,6 +207,8 @@ def run_sweep(points: Sequence[GridPoint], *, out: pathlib.Path, workers: int | 
     try:
         done = store.done()
         todo = [p for p in points if p.key not in done]
+        if progress is not None and len(points) > len(todo):
+            progress(len(points) - len(todo))  # a resumed sweep counts what was done before
 
         def on_done(rows: list[dict]) -> None:
             store.add(rows)

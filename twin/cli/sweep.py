@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import pathlib
+import signal
 import sys
 
 from twin.batch.lock import folder_lock
@@ -23,8 +24,12 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         raise InvalidScenario("the sweep names no axes: give at least one, e.g. --seed 0-4 (or --config GRID.toml)")
     points = grid.expand(axes)
     args.out.mkdir(exist_ok=True)
-    with folder_lock(args.out):  # one writer per folder: a second sweep into it is refused, naming this one
-        return _sweep(args, points)
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)  # SIGTERM stops it as Ctrl-C does
+    try:
+        with folder_lock(args.out):  # one writer per folder: a second sweep into it is refused, naming this one
+            return _sweep(args, points)
+    finally:
+        signal.signal(signal.SIGTERM, previous)
 
 
 def _sweep(args: argparse.Namespace, points: list) -> int:
