@@ -203,3 +203,35 @@ def test_an_interrupted_sweep_stops_at_once_keeps_what_finished_and_resumes(tmp_
     assert f"{total}/{total}" in again.stderr.replace("\r", "\n").splitlines()[-1] or f"{total}/{total}" in again.stderr
     with sqlite3.connect(out / "results.sqlite") as db:
         assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (total, total)
+
+
+def test_tables_read_cleanly_in_a_spreadsheet(tmp_path):
+    import csv
+
+    import numpy as np
+
+    from twin.batch.tables import write_csv
+
+    path = tmp_path / "t.csv"
+    write_csv([{"a": -0.0, "b": 6.000000000000001, "c": True, "d": np.False_, "e": float("nan"), "f": ["x", "y"],
+                "g": 0.1 + 0.2, "h": 1.2345678901234567e-7}], list("abcdefgh"), path)
+    with open(path) as handle:
+        row = next(csv.DictReader(handle))
+    assert row == {"a": "0.0", "b": "6.0", "c": "true", "d": "false", "e": "nan", "f": "x;y", "g": "0.3",
+                   "h": "1.23456789012e-07"}
+
+
+def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, capsys):
+    import csv
+    import json
+
+    assert main(["sweep", "--seed", "0", "--trajectory", "4", "--out", str(tmp_path / "s")]) == 0
+    with open(tmp_path / "s" / "results.csv") as handle:
+        row = next(csv.DictReader(handle))
+    assert row["noise"] == "true" and row["duration_s"] == "6.0"
+    capsys.readouterr()
+    assert main(["run", "--controller", "ffpva", "--trajectory", "4", "--json",
+                 "--trace", str(tmp_path / "t.csv")]) == 0
+    record = json.loads(capsys.readouterr().out)
+    assert record["noise"] is True and record["duration_s"] == 6.0
+    assert ",-0," not in (tmp_path / "t.csv").read_text() and ",-0\n" not in (tmp_path / "t.csv").read_text()

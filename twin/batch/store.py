@@ -71,6 +71,7 @@ class ResultStore:
         for row in self._db.execute(f"SELECT {', '.join(COLUMNS)} FROM results"):
             record = dict(zip(COLUMNS, row, strict=True))
             record["warnings"] = json.loads(record["warnings"])
+            record["noise"] = bool(record["noise"])  # SQLite keeps booleans as 0 / 1
             found[record["key"]] = record
         return [found[k] for k in keys if k in found]
 

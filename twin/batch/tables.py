@@ -8,12 +8,26 @@ import math
 import pathlib
 from collections.abc import Sequence
 
+import numpy as np
+
 from twin.batch.store import COLUMNS
 from twin.sim.metrics import spread
 
 GROUP_BY = ("controller", "trajectory", "payload_g", "orientation", "plant", "supply_kpa", "pwm_period_ms")
 SUMMARY_COLUMNS = GROUP_BY + ("runs", "failed", "rmse_mean_deg", "rmse_std_deg", "rmse_min_deg", "rmse_max_deg",
                               "sse_mean_deg", "sse_min_deg", "sse_max_deg", "max_error_deg")
+
+
+def _cell(value):
+    """One CSV cell: lists joined with ';', booleans as true / false (as in the JSON), no "-0", and floats
+    without binary noise in the last digits (6.000000000000001 -> 6.0; 12 significant digits)."""
+    if isinstance(value, list | tuple):
+        return ";".join(str(v) for v in value)
+    if isinstance(value, bool | np.bool_):
+        return "true" if value else "false"
+    if isinstance(value, float | np.floating) and math.isfinite(value):
+        return float(f"{float(value):.12g}") + 0.0
+    return value
 
 
 def write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
@@ -23,7 +37,7 @@ def write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) 
         writer = csv.DictWriter(handle, fieldnames=list(columns), extrasaction="ignore")
         writer.writeheader()
         for row in rows:
-            writer.writerow({c: (";".join(row[c]) if isinstance(row[c], list | tuple) else row[c]) for c in columns})
+            writer.writerow({c: _cell(row[c]) for c in columns})
     tmp.replace(path)  # never a half-written file
 
 

@@ -28,7 +28,7 @@ def summary(result: Result) -> dict:
         "sse_deg": None if math.isnan(m.sse) else math.degrees(m.sse),
         "rest_errors_deg": [math.degrees(e) for e in m.rest_errors],
         "max_error_deg": math.degrees(m.max_error),
-        "duration_s": float(result.trace.time[-1] + (result.trace.time[1] - result.trace.time[0])),
+        "duration_s": round(float(result.trace.time[-1] + (result.trace.time[1] - result.trace.time[0])), 9),
         "warnings": list(result.warnings),
     }
 
@@ -49,7 +49,7 @@ def trace_csv(result: Result) -> str:
     writer = csv.writer(out, lineterminator="\n")
     writer.writerow(TRACE_COLUMNS)
     for row in columns:
-        writer.writerow([f"{x:.6g}" for x in row])
+        writer.writerow([f"{x + 0.0:.6g}" for x in row])  # + 0.0: no "-0"
     return out.getvalue()
 
 
