@@ -104,7 +104,7 @@ def plot_lift(rows: Sequence[dict], path: pathlib.Path) -> None:
     p = [r["supply_kpa"] for r in rows]
     ax.plot(p, [r["lift_closed_form_g"] for r in rows], "k-", label="torque balance with friction")
     ax.plot(p, [r["lift_simulated_g"] for r in rows], "o", color="C3", label="simulation (bisection)")
-    ax.axhline(13.5, color="0.6", ls=":", label="13.5 g (thesis payload)")
+    ax.axhline(THESIS_PAYLOAD * 1e3, color="0.6", ls=":", label=f"{THESIS_PAYLOAD * 1e3:g} g (thesis payload)")
     finish(fig, ax, path, xlabel="supply pressure (kPa)", ylabel="heaviest tip payload lifted vertically (g)")
 
 
