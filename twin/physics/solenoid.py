@@ -118,14 +118,32 @@ def tick_openings(coil, substeps, h, tau_on, tau_off, force_ratio, gap_ratio, sp
                   opening):  # pragma: no cover - compiled
     """Every valve through one control tick of ``substeps`` steps of ``h`` with its coil ``coil`` (n, 4)
     held; ``state`` (n, 4, 3) = (i, x, v) in place; ``opening`` (n, 4) = the tick's mean lift x (its
-    mean opening area, a fraction of full). The plant's own inertia stands in for the water column."""
+    mean opening area, a fraction of full). The plant's own inertia stands in for the water column.
+
+    A valve at rest on the stop its coil holds it to (shut with the coil off, open with it on) stays
+    there while the magnetic force keeps holding it: those steps advance only the coil current, the
+    same arithmetic as :func:`_step`, so the numbers are identical and idle or held valves cost little."""
     rise, fall = 1.0 - math.exp(-h / tau_on), 1.0 - math.exp(-h / tau_off)
     for a in range(coil.shape[0]):
         for b in range(coil.shape[1]):
             s = coil[a, b]
             i, x, v = state[a, b, 0], state[a, b, 1], state[a, b, 2]
             total = 0.0
-            for _ in range(substeps):
+            k = 0
+            if v == 0.0 and ((s == 0.0 and x == 0.0) or (s == 1.0 and x == 1.0)):
+                # At rest on the stop its coil holds it to: while the force keeps holding it there, a step
+                # only moves the current (the rest of _step leaves x and v as they are), so only that is
+                # done. The same numbers as _step, without the plunger's arithmetic.
+                gap = 1.0 + gap_ratio * (1.0 - x)
+                while k < substeps:
+                    i_next = i + (s - i) * (rise if s > i else fall)
+                    force = force_ratio * i_next * i_next / (gap * gap) - (1.0 + spring_ratio * x)
+                    if (x == 0.0 and force > 0.0) or (x == 1.0 and force < 0.0):
+                        break
+                    i = i_next
+                    total += x
+                    k += 1
+            for _ in range(k, substeps):
                 i, x, v = _step(s, i, x, v, h, rise, fall, force_ratio, gap_ratio, spring_ratio, omega, zeta)
                 total += x
             state[a, b, 0], state[a, b, 1], state[a, b, 2] = i, x, v
