@@ -1,9 +1,8 @@
-"""The as-built calibration: twin against experiment per cell (SPEC §8)."""
+"""The as-built calibration: twin against measurement per cell (SPEC §8, §9's T1 cells)."""
 
 from __future__ import annotations
 
 import pathlib
-from collections.abc import Sequence
 
 import matplotlib
 
@@ -12,35 +11,47 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 
 
-def plot_calibration(rows: Sequence[dict], history: Sequence[dict], path: pathlib.Path,
-                     ensemble_rows: Sequence[dict], ensemble_size: int, check_size: int) -> None:
-    """Bars of RMSE (twin with its std over seeds, experiment with its std) per cell, each cell's 20 % bar,
-    the twin's mean over a larger ensemble of seeds as a marker where given, and the cost per evaluation."""
-    fig, (bars, trace) = plt.subplots(1, 2, figsize=(12, 4.5), gridspec_kw={"width_ratios": [3, 1]})
+def _label(r: dict) -> str:
+    where = "" if r.get("payload_g", 0) == 0 and r.get("orientation", "horizontal") == "horizontal" else \
+        f"\n{r['payload_g']:g} g {r['orientation'][0].upper()}"
+    return f"{r['controller']}\nT{r['trajectory']}{where}"
+
+
+def plot_calibration(data: dict, path: pathlib.Path) -> None:
+    """Left: RMSE per cell (measured with its std; twin with its std over the check seeds), each cell's
+    20 % bar, the twin's mean over the fit seeds as a marker. Right: the cost of every evaluation by
+    stage, the best cost and the noise band the ensemble was chosen in."""
+    rows, wide = data["residuals_check_seeds"], data["residuals_fit_seeds"]
+    fig, (bars, trace) = plt.subplots(1, 2, figsize=(15, 4.8), gridspec_kw={"width_ratios": [3.3, 1]})
     x = np.arange(len(rows))
-    labels = [f"{r['controller']}\nT{r['trajectory']}" for r in rows]
     bars.bar(x - 0.2, [r["experiment_rmse_deg"] for r in rows], 0.4, yerr=[r["experiment_std_deg"] for r in rows],
-             label="experiment (thesis §8)", color="0.6", capsize=3)
+             label="measured (thesis §8, §9 T1)", color="0.6", capsize=3)
     bars.bar(x + 0.2, [r["twin_rmse_deg"] for r in rows], 0.4, yerr=[r["twin_std_deg"] for r in rows],
-             label=f"as-built twin, mean of {check_size} seeds", color="tab:blue", capsize=3)
+             label=f"as-built twin, mean of {len(data['check_seeds'])} seeds", color="tab:blue", capsize=3)
     for xi, r in zip(x, rows, strict=True):
         target = r["experiment_rmse_deg"]
         bars.fill_between([xi, xi + 0.4], 0.8 * target, 1.2 * target, color="tab:green", alpha=0.25, lw=0,
-                          label="experiment ± 20 % (the issue's bar)" if xi == 0 else None)
+                          label="measured ± 20 %" if xi == 0 else None)
         bars.annotate(f"{100 * (r['ratio'] - 1):+.0f}%", (xi + 0.2, r["twin_rmse_deg"] + r["twin_std_deg"]),
-                      ha="center", va="bottom", fontsize=7, xytext=(0, 3), textcoords="offset points")
-    if ensemble_rows:
-        bars.plot(x + 0.2, [r["twin_rmse_deg"] for r in ensemble_rows], "kD", ms=4,
-                  label=f"as-built twin, mean of {ensemble_size} seeds")
-    bars.set_xticks(x, labels, fontsize=8)
+                      ha="center", va="bottom", fontsize=6.5, xytext=(0, 3), textcoords="offset points")
+    bars.plot(x + 0.2, [r["twin_rmse_deg"] for r in wide], "kD", ms=3.5,
+              label=f"as-built twin, mean of {len(data['noise']['seed_sets'][0])} fit seeds")
+    bars.set_xticks(x, [_label(r) for r in rows], fontsize=6.5)
     bars.set_ylabel("RMSE (deg)")
     bars.legend(fontsize=8)
     bars.set_title("as-built calibration: RMSE per cell")
-    trace.plot(np.arange(1, len(history) + 1), [h["cost"] for h in history], ".-", lw=0.8)
+    history = data["history"]
+    for stage, marker in (("scan", "o"), ("simplex", "."), ("profile", "s")):
+        idx = [i for i, h in enumerate(history) if h["stage"] == stage]
+        trace.plot([i + 1 for i in idx], [history[i]["cost"] for i in idx], marker, ls="none", ms=4, label=stage)
+    best, noise = data["cost"], data["noise"]["std"]
+    trace.axhspan(best, best + noise, color="tab:green", alpha=0.25, lw=0,
+                  label=f"best + noise ({len(data['ensemble'])} in ensemble)")
     trace.set_xlabel("evaluation")
     trace.set_ylabel("cost")
     trace.set_yscale("log")
-    trace.set_title("Nelder-Mead")
+    trace.legend(fontsize=7)
+    trace.set_title("search")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

@@ -7,6 +7,7 @@
     twin whatif payload --out DIR                          tracking against payload (also lift, pwm, gear-load, supply)
     twin study robustness --out DIR                        the thesis's Chapter 6 protocol
     twin study ablation --out DIR                          each as-built effect off in turn, against SPEC §8
+    twin validate --out DIR                                every published comparison and the blind T3 prediction
 
 Degrees, grams and kPa here; SI inside. Bad input gets a one-line error and
 exit code 2, and nothing is written. One module per command; each adds its own
@@ -18,11 +19,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from twin.cli import bench, calibrate, demo, experiments, run, sweep, view
+from twin.cli import bench, calibrate, demo, experiments, run, sweep, validate, view
 from twin.cli.common import EXIT_USAGE, Parser
 from twin.exceptions import TwinError
 
-COMMANDS = (demo, bench, sweep, experiments, run, calibrate, view)
+COMMANDS = (demo, bench, sweep, experiments, run, calibrate, validate, view)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -1,4 +1,4 @@
-"""``twin calibrate``: fit the as-built plant to the thesis's experiments (SPEC §8)."""
+"""``twin calibrate``: fit the as-built plant to the thesis's measurements (SPEC §8, §9's T1 cells)."""
 
 from __future__ import annotations
 
@@ -16,17 +16,14 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
     args.out.mkdir(exist_ok=True)
 
-    def progress(done: int, cost: float, values: dict) -> None:
+    def progress(done: int, total: int, stage: str, cost: float, values: dict) -> None:
         shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
-        print(f"[{done}/{args.max_evaluations}] cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
+        print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
 
-    if args.max_evaluations is None:
-        args.max_evaluations = calibrate.MAX_EVALUATIONS
-    result = calibrate.calibrate(workers=args.workers, max_evaluations=args.max_evaluations, progress=progress)
+    result = calibrate.calibrate(workers=args.workers, progress=progress)
     data = calibrate.record(result)
     path = calibrate.write(data, args.out)
-    plot_calibration(data["residuals_check_seeds"], data["history"], args.out / "calibration.png",
-                     data["residuals_ensemble_seeds"], len(data["ensemble_seeds"]), len(data["check_seeds"]))
+    plot_calibration(data, args.out / "calibration.png")
     print(calibrate.format_residuals(data))
     print(f"wrote {path} and {args.out / 'calibration.png'} ({result.evaluations} evaluations, "
           f"{result.wall_time:.0f} s)")
@@ -37,12 +34,10 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 
 
 def add_parser(sub) -> None:
-    cal = sub.add_parser("calibrate", help="fit the as-built plant to the thesis's experiments (SPEC §8)")
+    cal = sub.add_parser("calibrate", help="fit the as-built plant to the thesis's measurements (SPEC §8, §9 T1)")
     cal.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="results folder (created)")
     cal.add_argument("--workers", type=arguments.positive_int, default=max(1, min(os.cpu_count() or 1, 4)),
                      help="processes (default: the cores, at most 4)")
-    cal.add_argument("--max-evaluations", type=arguments.positive_int, default=None, metavar="N",
-                     help="optimiser budget (default: twin.experiments.calibrate.MAX_EVALUATIONS)")
     cal.add_argument("--install", action="store_true",
                      help="also make the result the as-built preset (twin/data/as_built.json)")
     cal.set_defaults(func=_cmd_calibrate)

@@ -23,3 +23,13 @@ THESIS_EXPERIMENT_SSE_T1_RANGE_DEG = {"pva": 0.41, "ffpva": 0.77, "smc": 0.85}
 
 # The robustness study's tip payloads (§9), g: none, then the thesis's two.
 THESIS_PAYLOADS_G = (0.0, *(round(m * 1e3, 9) for m in THESIS_PAYLOADS))
+
+# The robustness study (Chapter 6, §9), measured, T1 only: (controller, orientation) -> payload g ->
+# (mean RMSE of 5 runs, std, SSE range +- max |SSE|). Every run lifted its payload and tracked (none
+# stalled). The T3 cells are held back for a blind prediction and are not in the twin.
+THESIS_ROBUSTNESS_T1_DEG = {
+    ("ffpva", "horizontal"): {0.0: (1.40, 0.06, 0.77), 6.5: (1.69, 0.24, 1.17), 13.5: (1.75, 0.25, 1.19)},
+    ("ffpva", "vertical"): {0.0: (1.63, 0.22, 1.08), 6.5: (1.72, 0.18, 0.81), 13.5: (4.55, 0.45, 0.57)},
+    ("smc", "horizontal"): {0.0: (1.19, 0.11, 0.85), 6.5: (1.31, 0.13, 0.84), 13.5: (1.22, 0.17, 0.42)},
+    ("smc", "vertical"): {0.0: (1.57, 0.20, 0.86), 6.5: (1.51, 0.13, 0.68), 13.5: (3.48, 0.48, 0.90)},
+}

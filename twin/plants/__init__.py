@@ -20,8 +20,13 @@ controllers use on it.
     16 ms period, delays and 30 % dead zone.
 ``as-built``
     The joint as built (:mod:`twin.plants.as_built`): the thesis plant plus every
-    effect the thesis blames for its experiments' larger errors, as physics,
-    with the few parameters the thesis does not give fitted by ``twin calibrate``.
+    effect the thesis blames for its experiments' larger errors, as physics, on
+    the physical solenoid valve, with the few parameters the thesis does not give
+    fitted by ``twin calibrate``.
+``as-built~K``
+    Member K of the calibration ensemble (``as-built~0`` has the fitted values):
+    parameter sets that fit the measurements about as well as the fitted one.
+    Not listed; asked for by name, by the studies that report bands.
 """
 
 from __future__ import annotations
@@ -31,6 +36,8 @@ from collections.abc import Callable, Iterator, MutableMapping
 from twin.exceptions import InvalidScenario, TwinError
 from twin.plants import as_built
 from twin.plants.preset import THESIS_PARAMS, THESIS_PLANTS, Plant
+
+ENSEMBLE_PREFIX = "as-built~"  # as-built~K: member K of the calibration ensemble
 
 
 class PlantRegistry(MutableMapping):
@@ -44,6 +51,8 @@ class PlantRegistry(MutableMapping):
         self._lazy = dict(lazy)  # name -> (is it there, build it)
 
     def __getitem__(self, name: str) -> Plant:
+        if name not in self._plants and isinstance(name, str) and name.startswith(ENSEMBLE_PREFIX):
+            return self._member(name)
         if name not in self._plants:
             if name not in self._lazy or not self._lazy[name][0]():
                 raise KeyError(name)
@@ -53,12 +62,33 @@ class PlantRegistry(MutableMapping):
                 raise InvalidScenario(f"no {name} plant: {error}") from None
         return self._plants[name]
 
+    def _member(self, name: str) -> Plant:
+        """``as-built~K``: the calibration ensemble's member K (read from the calibration file, not listed)."""
+        index = name[len(ENSEMBLE_PREFIX):]
+        if not index.isdigit() or not as_built.CALIBRATION_FILE.exists():
+            raise KeyError(name)
+        try:
+            members = as_built.ensemble_plants()
+        except TwinError as error:
+            raise InvalidScenario(f"no {name} plant: {error}") from None
+        if int(index) >= len(members):
+            raise KeyError(name)
+        self._plants.update({m.name: m for m in members if m.name not in self._plants})
+        return self._plants[name]
+
     def __contains__(self, name: object) -> bool:
-        """Listed: loaded, or a lazy preset whose source is there (not loaded by asking)."""
+        """Listed: loaded, or a lazy preset whose source is there (not loaded by asking); also an
+        ensemble member that the calibration file has."""
+        if isinstance(name, str) and name.startswith(ENSEMBLE_PREFIX) and name not in self._plants:
+            try:
+                self._member(name)
+            except (KeyError, InvalidScenario):
+                return False
+            return True
         return name in self._plants or (name in self._lazy and self._lazy[name][0]())
 
     def __iter__(self) -> Iterator[str]:
-        yield from self._plants
+        yield from (name for name in self._plants if not name.startswith(ENSEMBLE_PREFIX))
         yield from (name for name, (present, _) in self._lazy.items() if name not in self._plants and present())
 
     def __len__(self) -> int:
@@ -93,4 +123,4 @@ def plant(name: str) -> Plant:
     return PLANTS[name]
 
 
-__all__ = ["PLANTS", "THESIS_PARAMS", "Plant", "PlantRegistry", "plant"]
+__all__ = ["ENSEMBLE_PREFIX", "PLANTS", "THESIS_PARAMS", "Plant", "PlantRegistry", "plant"]

@@ -1,5 +1,5 @@
 """The ``as-built`` plant: the thesis plant plus, as physics, every effect the
-thesis names as a cause of its experiments' 1.5-4x larger errors (§3, §4, §5, §8).
+thesis names as a cause of its experiments' 1.5-4x larger errors (§3, §4, §5, §8, §9).
 
 Effects (each switchable by name; all off gives the ``thesis`` plant exactly):
 
@@ -14,25 +14,24 @@ supply_line         the air-over-water supply reaching the valves through a hose
 stiction            breakaway force above Coulomb, varying along the stroke (a static friction
                     map, thesis future work 2): stick-slip
 ccw_friction        Coulomb friction larger moving towards 0 deg (the thesis tracked worse CCW)
-dead_zone           the valves' dead zone (§3: "about 30 %")
-held_supply         the pair's supply valve stays on while the discharge valve's pulses are too
-                    short to open it (§3: only the discharge valve is PWM'd, the supply valve
-                    "stays fully on"); with compressible chambers that leak, the joint then creeps
+solenoid_valve      the physical solenoid valve (:mod:`twin.physics.solenoid`): coils get the
+                    PWM signal, each plunger's lift is integrated inside the tick, so the delays,
+                    the ~30 % dead zone and short pulses' partial openings are outcomes, and
+                    sliding mode's 1 ms updates act inside the PWM period as on the rig; the
+                    pair's supply coil is on while any duty is commanded (§3). Off: the thesis's
+                    averaged eq. 4.4.2 valve with its 5 ms / 2 ms delays and no dead zone
 hall_calibration    the DAQ's eq. 4.2.1 against the sensor's measured calibration points (§5)
 experiment_gains    the controllers' experiment gains (§6), as on the real joint
 sensor_metrics      errors scored on the Hall reading, as the thesis's experiments were
 ==================  =========================================================================
 
-The valve stays the averaged eq. 4.4.2 with the 5 ms / 2 ms delays: eq. 4.4.2
-was measured on the real PWM'd valves, so it already holds what pulse-width
-modulation does on average (the time-resolved ``pwm`` valve, with incompressible
-water, tracks 3-5x worse than the experiments: it stalls the rack for most of each
-period, which the measured R(d) says the real joint does not).
-
-The parameters the thesis does not give are :data:`FITTED`, with the bounds that
-keep them physically plausible; ``twin calibrate`` fits them to §8's experimental
-table and writes ``twin/plants/data/as_built.json``, which this module reads. Other
-as-built values are assumptions, stated in :data:`ASSUMED`.
+The valve's own parameters are not fitted here: they come from the valve test replica
+(``python -m twin.experiments.valve_fit``, §4.4.3). The parameters the thesis does not give are
+:data:`FITTED`, with the bounds that keep them physically plausible; ``twin calibrate`` fits them to
+§8's experimental table and §9's measured T1 cells and writes ``twin/plants/data/as_built.json``,
+which this module reads: the fitted values (the committed preset) and an ensemble of parameter
+sets that fit about equally well (:func:`ensemble_values`). Other as-built values are
+assumptions, stated in :data:`ASSUMED`.
 """
 
 from __future__ import annotations
@@ -48,8 +47,8 @@ from twin.physics.params import ChamberParams, HallParams, JointParams, Stiction
 from twin.physics.valves import ValveModel
 from twin.plants.preset import THESIS_PARAMS, Plant
 
-EFFECTS = ("compressibility", "supply_line", "stiction", "ccw_friction", "dead_zone", "held_supply",
-           "hall_calibration", "experiment_gains", "sensor_metrics")
+EFFECTS = ("compressibility", "supply_line", "stiction", "ccw_friction", "solenoid_valve", "hall_calibration",
+           "experiment_gains", "sensor_metrics")
 CALIBRATION_FILE = importlib.resources.files("twin.plants") / "data" / "as_built.json"  # package data
 
 
@@ -64,11 +63,17 @@ class Fitted:
     why: str
 
 
+STICTION_SCATTER = 0.5  # N, the stiction map's scatter about the fitted breakaway (ASSUMED["stiction_map"])
+BREAKAWAY_TEST_PRESSURE = 245e3  # Pa: §4.5.1 started the joint from rest at 245 kPa, pair at 100 %, both ways
+# The highest fitted breakaway that lets every point of the map break away at 245 kPa: P A - scatter (2.58 N).
+BREAKAWAY_BOUND = BREAKAWAY_TEST_PRESSURE * THESIS_PARAMS.cylinder.bore_area - STICTION_SCATTER
+
 FITTED = (
-    Fitted("stiction", 1.0, 3.6, "N", "breakaway force. The thesis's 'average static friction 3.6 N' is the top: "
-           "at 300 kPa P_ws A is 3.77 N, and at 245 kPa (where the thesis measured the rack moving) 3.6 N would "
-           "not let it start; eq. 4.5.7's Coulomb peak (about 2 N) is near the bottom"),
-    Fitted("dead_zone_duty", 20.0, 35.0, "%", "SPEC §3: 'below about 30 % duty the valve does not open'"),
+    Fitted("stiction", 1.0, BREAKAWAY_BOUND, "N", "breakaway force about which the map scatters. Top: §4.5.1 "
+           "rotated the joint from rest at 245 kPa with both valves of the pair at 100 %, both ways, so the "
+           f"breakaway was below P A = {BREAKAWAY_TEST_PRESSURE * THESIS_PARAMS.cylinder.bore_area:.2f} N there; "
+           f"the map reaches {STICTION_SCATTER} N above the fitted value, hence P A - {STICTION_SCATTER} N. "
+           "Bottom: near eq. 4.5.7's Coulomb level (up to about 2 N)"),
     Fitted("air_fraction", 0.0, 0.03, "", "free air per chamber volume at 1 atm: none to 3 % (visibly bubbly "
            "water in 4 mm cylinders and hoses)"),
     Fitted("ccw_coulomb_scale", 1.0, 1.5, "", "Coulomb friction towards 0 deg relative to eq. 4.5.7, which "
@@ -82,24 +87,46 @@ ASSUMED = {
     "dead_volume": "0.3 mL per chamber at the end of stroke: ports, fittings and hose to the valve block",
     "initial_pressure_fraction": "both chambers start at half the supply (the thesis pre-charges the joint "
                                  "by moving it side to side; the shut valves then trap a middle pressure)",
-    "stiction_map": "scatter 0.5 N about the fitted breakaway, knots 1 mm apart, seed 0",
+    "stiction_map": f"scatter {STICTION_SCATTER} N about the fitted breakaway, knots 1 mm apart, one map per run "
+                    "(drawn from the run's seed)",
     "supply_line": "60 Hz, damping ratio 0.3, 2e-13 m^3/Pa at the valve block: a hose ringing near the 62.5 Hz "
                    "PWM as §3 describes, sagging ~10 kPa at full flow",
 }
 
 
+def _record(path: pathlib.Path) -> dict:
+    try:
+        return json.loads(path.read_text())
+    except (OSError, ValueError) as error:
+        raise InvalidScenario(f"cannot read the as-built calibration {path}: {error}") from None
+
+
+def _checked(values: object, path: pathlib.Path, what: str) -> dict[str, float]:
+    try:
+        out = {f.name: float(values[f.name]) for f in FITTED}  # type: ignore[index]
+    except (TypeError, ValueError, KeyError) as error:
+        raise InvalidScenario(f"cannot read the as-built calibration {path}: {what}: {error!r} missing or not "
+                              "a number") from None
+    for f in FITTED:
+        if not f.low <= out[f.name] <= f.high:
+            raise InvalidScenario(f"as-built {f.name} = {out[f.name]} is outside its plausible "
+                                  f"[{f.low}, {f.high}] {f.unit} ({what})")
+    return out
+
+
 def calibrated_values(path: pathlib.Path = CALIBRATION_FILE) -> dict[str, float]:
     """The fitted values from ``path`` (the committed calibration by default)."""
-    try:
-        record = json.loads(path.read_text())
-        values = {f.name: float(record["fitted"][f.name]) for f in FITTED}
-    except (OSError, ValueError, KeyError) as error:
-        raise InvalidScenario(f"cannot read the as-built calibration {path}: {error}") from None
-    for f in FITTED:
-        if not f.low <= values[f.name] <= f.high:
-            raise InvalidScenario(f"as-built {f.name} = {values[f.name]} is outside its plausible "
-                                  f"[{f.low}, {f.high}] {f.unit}")
-    return values
+    return _checked(_record(path).get("fitted"), path, "fitted values")
+
+
+def ensemble_values(path: pathlib.Path = CALIBRATION_FILE) -> list[dict[str, float]]:
+    """The calibration ensemble from ``path``: the parameter sets that fit the measurements about as
+    well as the fitted one (within the seed-to-seed noise of the best cost; ``twin calibrate``), the
+    fitted one first. A file without an ensemble gives the fitted values alone."""
+    record = _record(path)
+    members = record.get("ensemble") or [{"values": record.get("fitted")}]
+    return [_checked(m.get("values") if isinstance(m, dict) else None, path, f"ensemble member {k}")
+            for k, m in enumerate(members)]
 
 
 def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) -> tuple[JointParams, dict]:
@@ -120,18 +147,18 @@ def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) ->
         ccw_coulomb_scale=values["ccw_coulomb_scale"] if "ccw_friction" in on else 1.0)
     params = dataclasses.replace(
         base,
-        valves=dataclasses.replace(base.valves, dead_zone_duty=values["dead_zone_duty"] if "dead_zone" in on
-                                   else base.valves.dead_zone_duty, supply_held_in_dead_zone="held_supply" in on),
+        valves=base.valves,
         friction=friction,
         chambers=(ChamberParams(compressible=True, air_fraction=values["air_fraction"],
                                 leak_conductance=values["leak_conductance"])
                   if "compressibility" in on else ChamberParams()),
         supply_line=SupplyLineParams(model="line") if "supply_line" in on else SupplyLineParams(),
         hall=HallParams(calibration_error="hall_calibration" in on),
-        stiction_map=StictionMapParams(scatter=0.5) if "stiction" in on else StictionMapParams(),
+        stiction_map=StictionMapParams(scatter=STICTION_SCATTER) if "stiction" in on else StictionMapParams(),
     )
     options = {"gain_set": "experiment" if "experiment_gains" in on else "simulation",
-               "metrics_on_sensor": "sensor_metrics" in on}
+               "metrics_on_sensor": "sensor_metrics" in on,
+               "valve_model": ValveModel.SOLENOID if "solenoid_valve" in on else ValveModel.AVERAGED}
     return params, options
 
 
@@ -139,9 +166,15 @@ def as_built_plant(values: dict[str, float] | None = None, *, without: Iterable[
                    name: str = "as-built"):
     """The as-built :class:`twin.plants.Plant` (the committed calibration unless ``values`` are given)."""
     params, options = as_built_params(calibrated_values() if values is None else values, without=without)
-    return Plant(name, params, ValveModel.AVERAGED, options["gain_set"],
+    return Plant(name, params, options["valve_model"], options["gain_set"],
                  metrics_on_sensor=options["metrics_on_sensor"])
 
 
-__all__ = ["ASSUMED", "CALIBRATION_FILE", "EFFECTS", "FITTED", "as_built_params",
-           "as_built_plant", "calibrated_values"]
+def ensemble_plants(path: pathlib.Path = CALIBRATION_FILE) -> list:
+    """One :class:`twin.plants.Plant` per calibration ensemble member, named ``as-built~K`` (K from 0,
+    the fitted preset's values first)."""
+    return [as_built_plant(values, name=f"as-built~{k}") for k, values in enumerate(ensemble_values(path))]
+
+
+__all__ = ["ASSUMED", "BREAKAWAY_BOUND", "CALIBRATION_FILE", "EFFECTS", "FITTED", "STICTION_SCATTER",
+           "as_built_params", "as_built_plant", "calibrated_values", "ensemble_plants", "ensemble_values"]

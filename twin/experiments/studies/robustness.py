@@ -26,7 +26,7 @@ from twin.batch.tables import summarise, write_csv
 from twin.experiments.arguments import positive_int
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import THESIS_PAYLOADS_G
-from twin.plants import PLANTS, plant
+from twin.plants import ENSEMBLE_PREFIX, PLANTS, plant
 from twin.sim.scenario import CONTROLLER_LABELS, MODEL_BASED_CONTROLLERS
 from viz.figures import plt
 
@@ -39,7 +39,9 @@ RUN_COLUMNS = ("plant", "controller", "trajectory", "payload_g", "orientation", 
                "rmse_deg", "sse_deg", "max_error_deg", "warnings")
 SUMMARY_COLUMNS = ("plant", "controller", "trajectory", "payload_g", "orientation", "runs", "failed",
                    "rmse_mean_deg", "rmse_std_deg", "rmse_min_deg", "rmse_max_deg",
-                   "sse_min_deg", "sse_max_deg", "sse_range_deg", "max_error_deg")
+                   "sse_min_deg", "sse_max_deg", "sse_range_deg", "max_error_deg",
+                   "ensemble_members", "band_p10_deg", "band_p50_deg", "band_p90_deg")
+CELL = ("controller", "trajectory", "payload_g", "orientation")
 
 
 def default_plant(fallback: str) -> str:
@@ -58,14 +60,25 @@ class RobustnessStudy:
         return [r for r in self.runs if r["status"] != "ok"]
 
 
+def ensemble_members(plant_name: str) -> list[str]:
+    """The calibration ensemble's plant names (``as-built~K``) when ``plant_name`` is ``as-built``, else none."""
+    if plant_name != "as-built":
+        return []
+    from twin.plants.as_built import ensemble_values
+
+    return [f"{ENSEMBLE_PREFIX}{k}" for k in range(len(ensemble_values()))]
+
+
 def robustness_grid(*, plant_name: str, seeds: int = ROBUSTNESS_SEEDS,
-                    trajectories: Sequence[int] = ROBUSTNESS_TRAJECTORIES) -> list[GridPoint]:
+                    trajectories: Sequence[int] = ROBUSTNESS_TRAJECTORIES, ensemble: bool = False) -> list[GridPoint]:
     """The Chapter 6 protocol: controllers x trajectories x payloads x orientations x seeds 0..seeds-1
-    (120 points with the defaults), each checked by building its scenario."""
+    (120 points with the defaults), each checked by building its scenario; with ``ensemble`` (as-built
+    only) the same again on each calibration ensemble member."""
     plant(plant_name)  # an unknown name fails here, with the preset names
+    plants = [plant_name] + (ensemble_members(plant_name) if ensemble else [])
     return expand({"controller": list(ROBUSTNESS_CONTROLLERS), "trajectory": list(trajectories),
                    "payload": list(ROBUSTNESS_PAYLOADS_G), "orientation": list(ROBUSTNESS_ORIENTATIONS),
-                   "plant": [plant_name], "seed": list(range(seeds))})
+                   "plant": plants, "seed": list(range(seeds))})
 
 
 def _finite(value: float | None) -> float | None:
@@ -101,13 +114,33 @@ def summary_rows(records: Sequence[dict]) -> list[dict]:
     return rows
 
 
+def with_band(summary: list[dict], member_records: Sequence[dict]) -> list[dict]:
+    """``summary`` with, per cell, the ensemble members' five-run mean RMSE: how many members, and the
+    10 / 50 / 90 % percentiles of their means (empty without members)."""
+    means: dict[tuple, list[float]] = {}
+    for s in summary_rows(member_records):
+        if s["rmse_mean_deg"] is not None:
+            means.setdefault(tuple(s[c] for c in CELL), []).append(s["rmse_mean_deg"])
+    out = []
+    for s in summary:
+        found = means.get(tuple(s[c] for c in CELL), [])
+        band = [float(np.percentile(found, q)) for q in (10, 50, 90)] if found else [None] * 3
+        out.append({**s, "ensemble_members": len(found), "band_p10_deg": band[0], "band_p50_deg": band[1],
+                    "band_p90_deg": band[2]})
+    return out
+
+
 def robustness_study(*, out: pathlib.Path, plant_name: str, seeds: int = ROBUSTNESS_SEEDS,
                      trajectories: Sequence[int] = ROBUSTNESS_TRAJECTORIES, workers: int | None = None,
-                     progress: Callable[[int], None] | None = None) -> RobustnessStudy:
-    """Run the protocol (what ``out/results.sqlite`` holds already is not run again) and tabulate it."""
-    records = run_sweep(robustness_grid(plant_name=plant_name, seeds=seeds, trajectories=trajectories),
-                        out=out, workers=workers, progress=progress).records
-    return RobustnessStudy(runs=[run_row(r) for r in records], summary=summary_rows(records), seeds=seeds)
+                     progress: Callable[[int], None] | None = None, ensemble: bool = False) -> RobustnessStudy:
+    """Run the protocol (what ``out/results.sqlite`` holds already is not run again) and tabulate it;
+    with ``ensemble`` (as-built only) also on each calibration ensemble member, for the band."""
+    records = run_sweep(robustness_grid(plant_name=plant_name, seeds=seeds, trajectories=trajectories,
+                                        ensemble=ensemble), out=out, workers=workers, progress=progress).records
+    own = [r for r in records if r["plant"] == plant_name]
+    members = [r for r in records if r["plant"] != plant_name]
+    return RobustnessStudy(runs=[run_row(r) for r in own], summary=with_band(summary_rows(own), members),
+                           seeds=seeds)
 
 
 def write_robustness(study: RobustnessStudy, out: pathlib.Path) -> list[pathlib.Path]:
@@ -152,10 +185,15 @@ def format_robustness(study: RobustnessStudy) -> str:
              "or error) are left out of every statistic", ""]
     lines += _per_run_table(study, 1, "sse_deg", "T1: steady-state error per run and its range (± max |SSE|)",
                             ("range",), lambda s: (f"±{_number(s['sse_range_deg'])}",))
+    banded = any(s.get("ensemble_members") for s in study.summary)
     for trajectory in sorted({s["trajectory"] for s in study.summary}):
-        lines += _per_run_table(study, trajectory, "rmse_deg", f"T{trajectory}: RMSE per run, mean and std",
-                                ("mean", "std"),
-                                lambda s: (_number(s["rmse_mean_deg"]), _number(s["rmse_std_deg"])))
+        lines += _per_run_table(study, trajectory, "rmse_deg", f"T{trajectory}: RMSE per run, mean and std"
+                                + (", the calibration ensemble's median and 10-90 % band" if banded else ""),
+                                ("mean", "std", "p50", "p10-p90") if banded else ("mean", "std"),
+                                lambda s: (_number(s["rmse_mean_deg"]), _number(s["rmse_std_deg"]))
+                                + ((_number(s.get("band_p50_deg")),
+                                    f"{_number(s.get('band_p10_deg'))}-{_number(s.get('band_p90_deg'))}")
+                                   if banded else ()))
     failed = study.failed
     lines.append(f"{len(study.runs)} runs, {len(failed)} failed")
     lines += [f"failed: {CONTROLLER_LABELS[r['controller']]} T{r['trajectory']} {r['payload_g']:g} g {r['orientation']} "
@@ -224,6 +262,8 @@ class RobustnessStudyExperiment(Experiment):
         parser.add_argument("--seeds", type=positive_int, default=ROBUSTNESS_SEEDS, help="noise seeds per case (default 5)")
         parser.add_argument("--workers", type=positive_int, default=None, help="processes (default: all cores)")
         parser.add_argument("--plant", default=None, metavar="NAME", help="default: as-built if present, else thesis")
+        parser.add_argument("--no-ensemble", dest="ensemble", action="store_false",
+                            help="as-built: skip the calibration ensemble's runs (no band in the summary)")
 
     def check(self, args: argparse.Namespace) -> None:
         args.plant = args.plant or default_plant("thesis")
@@ -232,11 +272,12 @@ class RobustnessStudyExperiment(Experiment):
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         from tqdm import tqdm
 
-        points = robustness_grid(plant_name=args.plant, seeds=args.seeds)
+        args.ensemble = getattr(args, "ensemble", True) and args.plant == "as-built"
+        points = robustness_grid(plant_name=args.plant, seeds=args.seeds, ensemble=args.ensemble)
         print(f"{len(points)} runs on the {args.plant} plant -> {out.resolve()}", file=sys.stderr)
         with tqdm(total=len(points), unit="run", file=sys.stderr, dynamic_ncols=True, desc="robustness") as bar:
             study = robustness_study(out=out, plant_name=args.plant, seeds=args.seeds, workers=args.workers,
-                                     progress=bar.update)
+                                     progress=bar.update, ensemble=args.ensemble)
         return Outcome(rows=study.summary, answer=format_robustness(study), failed=len(study.failed), detail=study)
 
     def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:

@@ -1,0 +1,110 @@
+"""``twin validate``: the three files, their columns, the band, and a report that says what misses."""
+
+from __future__ import annotations
+
+import csv
+import math
+import os
+import pathlib
+import subprocess
+import sys
+
+import pytest
+
+from twin.experiments import validate
+from twin.experiments.reference import THESIS_PAYLOADS_G
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+VALIDATION_COLUMNS = ["source", "controller", "trajectory", "payload_g", "orientation", "plant", "measured",
+                      "twin_mean", "twin_std", "ratio", "within_tolerance"]
+PREDICTION_COLUMNS = ["controller", "trajectory", "payload_g", "orientation", "twin_mean", "band_p10", "band_p50",
+                      "band_p90", "stalled_runs"]
+
+
+def twin(cwd: pathlib.Path, *args: str) -> subprocess.CompletedProcess:
+    env = dict(os.environ, PYTHONPATH=str(ROOT), PYTHONIOENCODING="utf-8", MPLBACKEND="Agg")
+    return subprocess.run([sys.executable, "-m", "twin", *args], cwd=cwd, env=env, capture_output=True,
+                          text=True, encoding="utf-8", timeout=900)
+
+
+def rows_of(path: pathlib.Path) -> tuple[list[str], list[dict]]:
+    with open(path, newline="") as handle:
+        reader = csv.DictReader(handle)
+        return list(reader.fieldnames or []), list(reader)
+
+
+@pytest.mark.slow  # about 80 s on 2 cores: every comparison and the ensemble's T3 runs
+def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
+    out = tmp_path / "v"
+    proc = twin(tmp_path, "validate", "--out", str(out))
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    columns, rows = rows_of(out / "validation.csv")
+    assert columns == VALIDATION_COLUMNS
+    sources = [r["source"] for r in rows]
+    assert sources.count("chapter 5 simulation") == 8
+    assert sources.count("chapter 5 experiment") == 11 and sources.count("chapter 6 T1") == 10
+    assert sources.count("chapter 5 experiment, T1 SSE range") == 3
+    assert sources.count("chapter 6 T1, T1 SSE range") == 10
+    assert sum(s.startswith("4.4.3 valve test, R at") for s in sources) == 15
+    assert sum(s.startswith("4.6 open-loop") for s in sources) == 1
+    assert {r["within_tolerance"] for r in rows} <= {"true", "false"}
+    for r in rows:
+        if r["ratio"]:
+            assert float(r["ratio"]) == pytest.approx(float(r["twin_mean"]) / float(r["measured"]), rel=1e-9)
+    columns, predicted = rows_of(out / "prediction.csv")
+    assert columns == PREDICTION_COLUMNS
+    assert {(r["controller"], float(r["payload_g"]), r["orientation"]) for r in predicted} == {
+        (c, g, o) for c in ("ffpva", "smc") for g in THESIS_PAYLOADS_G for o in ("horizontal", "vertical")}
+    assert all(r["trajectory"] == "3" for r in predicted)
+    for r in predicted:
+        assert float(r["band_p10"]) <= float(r["band_p50"]) <= float(r["band_p90"])
+        assert int(r["stalled_runs"]) >= 0 and math.isfinite(float(r["twin_mean"]))
+    report = (out / "validation.md").read_text()
+    assert "## Why, as far as the twin shows" in report and "## Prediction: Chapter 6 T3 (blind)" in report
+    for name in ("validation.png", "prediction.png"):
+        assert (out / name).read_bytes().startswith(b"\x89PNG")
+    assert not list(out.glob("*.tmp*"))
+    assert "wrote" in proc.stdout and "prediction.csv" in proc.stdout
+
+
+def test_validate_without_a_calibration_is_a_one_line_error_and_writes_nothing(tmp_path, monkeypatch, capsys):
+    from twin.cli import main
+    from twin.plants import as_built
+
+    monkeypatch.setattr(as_built, "CALIBRATION_FILE", tmp_path / "missing.json")
+    monkeypatch.setattr(as_built.calibrated_values, "__defaults__", (tmp_path / "missing.json",))
+    monkeypatch.setattr(as_built.ensemble_values, "__defaults__", (tmp_path / "missing.json",))
+    assert main(["validate", "--out", str(tmp_path / "v")]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("twin: error: cannot read the as-built calibration")
+    assert not (tmp_path / "v").exists()
+
+
+def _fake(ratio_13_5: float, lag_within: bool, stalled: int) -> validate.Validation:
+    row = validate._row
+    rows = [row("chapter 5 experiment", c, t, 0.0, "horizontal", "as-built", m, m * k, 0.1, abs(k - 1) <= 0.2)
+            for c, t, m, k in (("pva", 1, 4.2, 0.4), ("ffpva", 1, 1.4, 1.0), ("smc", 1, 1.19, 0.9),
+                               ("pva", 2, 2.93, 0.75), ("ffpva", 2, 2.08, 1.0), ("smc", 2, 1.55, 1.5))]
+    rows.append(row("chapter 6 T1", "smc", 1, 13.5, "vertical", "as-built", 3.48, 3.48 * ratio_13_5, 0.1,
+                    abs(ratio_13_5 - 1) <= 0.2))
+    rows.append(row("4.6 open-loop mean lag at reversals (ms)", None, None, None, None, "as-built", 100.0,
+                    120.0 if lag_within else 70.0, None, lag_within))
+    prediction = [{"controller": "smc", "trajectory": 3, "payload_g": 13.5, "orientation": "vertical",
+                   "twin_mean": 2.9, "band_p10": 2.8, "band_p50": 2.9, "band_p90": 3.1, "stalled_runs": stalled}]
+    detail = {"members": [{"stiction": 1.0}, {"stiction": 2.2}], "runs": 10, "per_member": [[2.8], [3.1]]}
+    return validate.Validation(rows=rows, prediction=prediction, prediction_detail=detail, openloop=None,
+                               failed=0, stalled={("smc", 1, 13.5, "vertical"): 0})
+
+
+def test_report_says_plainly_what_misses_and_what_the_runs_show():
+    text = validate.report(_fake(0.6, lag_within=False, stalled=0))
+    assert "| chapter 5 experiment | as-built | 3 of 6 |" in text
+    assert "right on 1 of 2 trajectories" in text  # T2: measured smc < ffpva < pva, twin ffpva < pva < smc
+    assert "T2: measured sliding mode < FF + PVA < PVA + DZC, twin FF + PVA < PVA + DZC < sliding mode" in text
+    assert "T1: measured" not in text  # right there
+    assert "does **not** lag the model" in text and "tracks it better than the real joint did" in text
+    assert "spans 1.00-2.20 N" in text and "no run of any member stalls" in text
+    assert "does not turn on it" in text  # a 0.3 deg band
+    other = validate.report(_fake(1.0, lag_within=True, stalled=3))
+    assert "lags the model, as the real joint did" in other and "Within tolerance." in other
+    assert "some members' runs stall" in other
