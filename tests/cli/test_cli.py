@@ -173,7 +173,7 @@ def test_without_switches_off_as_built_effects_by_name(tmp_path):
 
 @pytest.mark.parametrize("args, bad", [
     (["--plant", "as-built", "--without", "friction"], "friction"),
-    (["--plant", "thesis", "--without", "dead_zone"], "'thesis'"),
+    (["--plant", "thesis", "--without", "solenoid_valve"], "'thesis'"),
     (["--plant", "as-built", "--without", "compressibility"], "supply_line off too"),
 ])
 def test_without_refuses_what_it_cannot_switch_off(tmp_path, args, bad):

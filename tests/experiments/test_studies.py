@@ -85,8 +85,10 @@ def test_reduced_robustness_run_writes_three_files_and_marks_a_failed_run(tmp_pa
     columns, summary = _rows(tmp_path / "robustness_summary.csv")
     assert columns == ["plant", "controller", "trajectory", "payload_g", "orientation", "runs", "failed",
                        "rmse_mean_deg", "rmse_std_deg", "rmse_min_deg", "rmse_max_deg", "sse_min_deg",
-                       "sse_max_deg", "sse_range_deg", "max_error_deg"]
+                       "sse_max_deg", "sse_range_deg", "max_error_deg", "ensemble_members", "band_p10_deg",
+                       "band_p50_deg", "band_p90_deg"]
     assert len(summary) == 12
+    assert all(s["ensemble_members"] == "0" and s["band_p50_deg"] == "" for s in summary)  # thesis: no ensemble
     bad = next(s for s in summary if (s["controller"], s["payload_g"], s["orientation"]) == ("smc", "13.5", "vertical"))
     assert (bad["runs"], bad["failed"], bad["rmse_mean_deg"]) == ("1", "1", "")  # not kept in the statistics
     for s in summary:
@@ -310,3 +312,27 @@ def test_cli_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, args, 
     assert len(lines) == 1 and lines[0].startswith("twin"), proc.stderr
     assert bad in lines[0]
     assert list(tmp_path.iterdir()) == []
+
+
+def test_the_band_is_the_ensemble_members_percentiles_per_cell():
+    def record(plant, seed, rmse):
+        return {"plant": plant, "controller": "smc", "trajectory": 3, "payload_g": 13.5, "orientation": "vertical",
+                "seed": seed, "status": "ok", "rmse_deg": rmse, "sse_deg": None, "max_error_deg": 5.0,
+                "reason": None, "supply_kpa": None, "pwm_period_ms": None}
+
+    own = [record("as-built", s, 2.0) for s in range(2)]
+    members = [record(f"as-built~{k}", s, float(k) + s) for k in range(5) for s in range(2)]  # means 0.5 .. 4.5
+    (row,) = robustness.with_band(robustness.summary_rows(own), members)
+    assert row["rmse_mean_deg"] == pytest.approx(2.0) and row["ensemble_members"] == 5
+    assert (row["band_p10_deg"], row["band_p50_deg"], row["band_p90_deg"]) == pytest.approx((0.9, 2.5, 4.1))
+
+
+def test_the_robustness_grid_on_as_built_adds_each_ensemble_member():
+    from twin.plants.as_built import ensemble_values
+
+    plain = robustness.robustness_grid(plant_name="as-built", seeds=1)
+    banded = robustness.robustness_grid(plant_name="as-built", seeds=1, ensemble=True)
+    members = len(ensemble_values())
+    assert len(banded) == len(plain) * (1 + members)
+    assert {p.plant for p in banded} == {"as-built", *(f"as-built~{k}" for k in range(members))}
+    assert robustness.ensemble_members("thesis") == []

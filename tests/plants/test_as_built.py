@@ -359,7 +359,8 @@ def creep_closed_form(direction: float) -> float:
 
 @pytest.mark.parametrize("direction", [1.0, -1.0])
 def test_held_supply_valve_creeps_the_rack_at_the_leak_rate(direction):
-    """The as-built plant's held_supply effect: no discharge valve open, yet the rack moves (1.5 deg/s here)."""
+    """The supply coil held on below the dead zone (the solenoid valve, §3): no discharge valve open, yet the
+    rack moves (1.5 deg/s here)."""
     circuit = make_circuit(friction_params=THESIS_FRICTION, leak=LEAK, initial_pressure=150e3)
     g = conductances(g1=G_OPEN) if direction > 0 else conductances(g3=G_OPEN)
     v, stuck = np.zeros(1), np.ones(1, dtype=bool)

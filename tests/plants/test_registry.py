@@ -78,3 +78,17 @@ def test_registry_repr_is_the_dict_of_its_presets():
 def test_unknown_plant_names_the_choices():
     with pytest.raises(InvalidScenario, match="unknown plant 'nope': choose one of thesis, "):
         plant("nope")
+
+
+def test_ensemble_members_are_plants_by_name_but_not_listed():
+    from twin.plants import PLANTS
+    from twin.plants.as_built import ensemble_values
+
+    members = ensemble_values()
+    assert "as-built~0" in PLANTS and PLANTS["as-built~0"].params == PLANTS["as-built"].params
+    last = PLANTS[f"as-built~{len(members) - 1}"]
+    assert last.params.friction.stiction == members[-1]["stiction"]
+    assert f"as-built~{len(members)}" not in PLANTS and "as-built~x" not in PLANTS
+    assert not any(name.startswith("as-built~") for name in PLANTS)  # not listed, so not in the sweep hash
+    with pytest.raises(KeyError):
+        PLANTS[f"as-built~{len(members)}"]
