@@ -166,8 +166,8 @@ def test_demo_writes_results_and_summary(tmp_path):
 @pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_without_switches_off_as_built_effects_by_name(tmp_path):
     full = run_json(tmp_path, "--plant", "as-built", "--seed", "0")
-    ablated = run_json(tmp_path, "--plant", "as-built", "--seed", "0", "--without", "stiction,dead_zone")
-    assert ablated["plant"] == "as-built-without-dead_zone+stiction"
+    ablated = run_json(tmp_path, "--plant", "as-built", "--seed", "0", "--without", "stiction,solenoid_valve")
+    assert ablated["plant"] == "as-built-without-solenoid_valve+stiction"
     assert ablated["rmse_deg"] != full["rmse_deg"]
 
 

@@ -3,6 +3,17 @@
 
 from __future__ import annotations
 
+import contextlib
+import csv
+import errno
+import os
+import pathlib
+import random
+import signal
+import sqlite3
+import subprocess
+import sys
+import time
 import warnings
 
 import numpy as np
@@ -147,62 +158,221 @@ def test_every_command_errors_with_one_prefix(argv, capsys, tmp_path, monkeypatc
     assert list(tmp_path.iterdir()) == []
 
 
-def test_bench_names_each_stage_as_it_starts(monkeypatch):
-    """The measurements themselves are stubbed: only the progress reports are under test."""
-    from types import SimpleNamespace
+def _sweep_argv(out: pathlib.Path) -> list[str]:
+    """A sweep long enough to be stopped part-way: 480 as-built scenarios on 2 workers (about 1 min)."""
+    return [sys.executable, "-m", "twin", "sweep", "--controller", "ffpva,smc", "--trajectory", "1,3",
+            "--payload", "0:10:2", "--seed", "0-19", "--plant", "as-built", "--workers", "2", "--out", str(out)]
 
-    from twin.experiments import bench
 
-    monkeypatch.setattr(bench, "run_many", lambda scenarios, **k: [SimpleNamespace(trace=SimpleNamespace(time=[0] * 3000))])
-    monkeypatch.setattr(bench, "_bare_step_cost", lambda seconds: 1.0)
-    monkeypatch.setattr(bench, "_fastest", lambda work, repeats: 1.0)
-    monkeypatch.setattr(bench, "_env_cost", lambda trajectory, duration: 1.0)
-    monkeypatch.setattr(bench, "_sweep_walls", lambda workers: ({1: 1.0}, 1.0))
-    stages: list[str] = []
-    bench.measure(batch_size=3, progress=stages.append)
-    assert [s.split("]")[0] for s in stages] == ["[1/4", "[2/4", "[3/4", "[4/4"]
+SWEEP_TOTAL = 2 * 2 * 6 * 20
+
+
+def _stored(out: pathlib.Path, what: str = "COUNT(*)"):
+    """``SELECT what`` over the sweep's store (0 / no rows while it does not exist yet)."""
+    try:
+        with sqlite3.connect(out / "results.sqlite") as db:
+            return db.execute(f"SELECT {what} FROM results").fetchall() if what == "key" else \
+                db.execute(f"SELECT {what} FROM results").fetchone()[0]
+    except sqlite3.Error:
+        return [] if what == "key" else 0
+
+
+def _start_and_wait_for_a_first_row(out: pathlib.Path, **popen) -> subprocess.Popen:
+    proc = subprocess.Popen(_sweep_argv(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
+    deadline = time.monotonic() + 120
+    while _stored(out) == 0 and time.monotonic() < deadline and proc.poll() is None:
+        time.sleep(0.05)
+    assert proc.poll() is None, "the sweep finished before it could be interrupted: make the grid larger"
+    return proc
+
+
+def _resume_completes_with_every_row_once(out: pathlib.Path, kept: int) -> None:
+    """The same command again: it runs only what is missing, counts the rest, and results.csv holds every
+    scenario of the grid exactly once."""
+    again = subprocess.run(_sweep_argv(out), capture_output=True, text=True, timeout=600)
+    assert again.returncode == 0, again.stderr
+    assert f"{SWEEP_TOTAL - kept} run, {kept} already done, 0 failed" in again.stdout
+    assert f"{SWEEP_TOTAL}/{SWEEP_TOTAL}" in again.stderr
+    with sqlite3.connect(out / "results.sqlite") as db:
+        assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (SWEEP_TOTAL, SWEEP_TOTAL)
+    with open(out / "results.csv") as handle:
+        keys = [row["key"] for row in csv.DictReader(handle)]
+    assert len(keys) == len(set(keys)) == SWEEP_TOTAL
 
 
 @pytest.mark.slow  # over ~2.5 s on 2 cores
 @pytest.mark.parametrize("stop", ["SIGINT", "SIGTERM"])
 def test_an_interrupted_sweep_stops_at_once_keeps_what_finished_and_resumes(tmp_path, stop):
-    import signal
-    import sqlite3
-    import subprocess
-    import sys
-    import time
-
     out = tmp_path / "sweep"
-    argv = [sys.executable, "-m", "twin", "sweep", "--controller", "ffpva,smc", "--trajectory", "1,3",
-            "--payload", "0:10:2", "--seed", "0-19", "--plant", "as-built", "--workers", "2", "--out", str(out)]
-    total = 2 * 2 * 6 * 20
-
-    def stored() -> int:
-        try:
-            with sqlite3.connect(out / "results.sqlite") as db:
-                return db.execute("SELECT COUNT(*) FROM results").fetchone()[0]
-        except sqlite3.Error:
-            return 0
-
-    proc = subprocess.Popen(argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
-    deadline = time.monotonic() + 120
-    while stored() == 0 and time.monotonic() < deadline and proc.poll() is None:
-        time.sleep(0.05)
-    assert proc.poll() is None, "the sweep finished before it could be interrupted: make the grid larger"
+    proc = _start_and_wait_for_a_first_row(out)
     sent = time.monotonic()
     proc.send_signal(getattr(signal, stop))
     _, err = proc.communicate(timeout=60)
     assert time.monotonic() - sent < 2.0  # measured 0.4 s
     assert proc.returncode == 130 and "interrupted: finished scenarios are kept" in err
-    kept = stored()
-    assert 0 < kept < total
+    kept = _stored(out)
+    assert 0 < kept < SWEEP_TOTAL
+    _resume_completes_with_every_row_once(out, kept)
 
-    again = subprocess.run(argv, capture_output=True, text=True, timeout=600)
-    assert again.returncode == 0, again.stderr
-    assert f"{total - kept} run, {kept} already done, 0 failed" in again.stdout
-    assert f"{total}/{total}" in again.stderr.replace("\r", "\n").splitlines()[-1] or f"{total}/{total}" in again.stderr
-    with sqlite3.connect(out / "results.sqlite") as db:
-        assert db.execute("SELECT COUNT(*), COUNT(DISTINCT key) FROM results").fetchone() == (total, total)
+
+def _children(pid: int) -> list[int]:
+    """The PIDs of ``pid``'s child processes (its sweep workers), from /proc."""
+    found = []
+    for task in pathlib.Path(f"/proc/{pid}/task").iterdir():
+        found += [int(c) for c in (task / "children").read_text().split()]
+    return found
+
+
+_draws = random.Random(16)
+KILL_DELAYS = [round(_draws.uniform(0.0, 4.0), 2) for _ in range(3)]  # s after the first stored row
+
+
+@pytest.mark.slow  # over ~2.5 s on 2 cores (a whole sweep each)
+@pytest.mark.parametrize("delay", KILL_DELAYS)
+def test_a_sweep_killed_at_a_random_point_resumes_with_every_finished_row_once(tmp_path, delay):
+    """SIGKILL to the sweep and its workers (its process group, as the OOM killer of a cgroup, ``timeout -s
+    KILL`` or a closed session would) at a seeded random moment after its first stored row: no clean-up
+    runs, yet every row stored before the kill is in the resumed sweep's results.csv exactly once."""
+    out = tmp_path / "sweep"
+    proc = _start_and_wait_for_a_first_row(out, start_new_session=True)
+    time.sleep(delay)
+    assert proc.poll() is None, "the sweep finished before the kill: make the grid larger"
+    os.killpg(proc.pid, signal.SIGKILL)
+    proc.communicate(timeout=60)
+    assert proc.returncode == -signal.SIGKILL
+    finished = {key for (key,) in _stored(out, "key")}
+    assert 0 < len(finished) < SWEEP_TOTAL
+    _resume_completes_with_every_row_once(out, len(finished))
+    with open(out / "results.csv") as handle:
+        assert finished <= {row["key"] for row in csv.DictReader(handle)}
+
+
+@pytest.mark.slow  # over ~2.5 s on 2 cores
+def test_a_sweep_whose_parent_alone_is_killed_leaves_no_workers_and_resumes(tmp_path):
+    out = tmp_path / "sweep"
+    proc = _start_and_wait_for_a_first_row(out)
+    workers = _children(proc.pid)
+    try:
+        proc.kill()  # the parent only (the OOM killer picks one process)
+        proc.wait(timeout=10)  # not communicate(): workers that outlive it hold its pipes open
+        proc.stdout.close()
+        proc.stderr.close()
+        kept = _stored(out)
+        time.sleep(2.0)
+        alive = [pid for pid in workers if pathlib.Path(f"/proc/{pid}").exists()
+                 and pathlib.Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"]
+        assert alive == [], f"workers {alive} outlived their killed sweep"
+        _resume_completes_with_every_row_once(out, kept)
+    finally:
+        for pid in workers:  # this test's own processes, by PID
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+
+
+@contextlib.contextmanager
+def _tmpfs(folder: pathlib.Path, size: str):
+    """A tiny RAM file system on ``folder`` (needs root: skipped where it cannot be mounted)."""
+    folder.mkdir()
+    mounted = subprocess.run(["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(folder)],
+                             capture_output=True, text=True)
+    if mounted.returncode != 0:
+        pytest.skip(f"cannot mount a tmpfs here: {mounted.stderr.strip()}")
+    try:
+        yield folder
+    finally:
+        subprocess.run(["umount", str(folder)], check=True)
+
+
+def _after_disk_full(capsys, folder: pathlib.Path, code: int) -> list[str]:
+    """Exit 2 and, last on stderr (after any progress bar), one line saying the disk is full; what is left
+    in ``folder``."""
+    assert code == 2
+    err = capsys.readouterr().err
+    errors = [line for line in err.splitlines() if line.startswith("twin: error:")]
+    assert len(errors) == 1 and err.rstrip().endswith(errors[0]) and "Traceback" not in err, err
+    assert "No space left on device" in errors[0], errors[0]
+    return sorted(p.name for p in folder.iterdir())
+
+
+@pytest.mark.parametrize("size", ["128k", "240k"])  # full in the trace (205 KB), full in the plot (55 KB)
+def test_a_full_disk_leaves_no_output_of_twin_run(tmp_path, capsys, size):
+    with _tmpfs(tmp_path / "disk", size) as disk:
+        code = main(["run", "--controller", "ffpva", "--trajectory", "1", "--trace", str(disk / "t.csv"),
+                     "--plot", str(disk / "t.png")])
+        assert _after_disk_full(capsys, disk, code) == []  # neither output, nor a temporary
+
+
+def test_a_disk_that_fills_while_the_trace_is_written_leaves_no_output_of_twin_run(tmp_path, capsys, monkeypatch):
+    """The same without root: the trace writer fills the disk after its first bytes."""
+    from twin.sim import report
+
+    def write_until_full(result, path):
+        pathlib.Path(path).write_text("time_s,angle_deg\n0.0,")
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+
+    monkeypatch.setattr(report, "write_trace", write_until_full)
+    code = main(["run", "--controller", "ffpva", "--trajectory", "1", "--trace", str(tmp_path / "t.csv"),
+                 "--plot", str(tmp_path / "t.png")])
+    assert _after_disk_full(capsys, tmp_path, code) == []
+
+
+@pytest.mark.parametrize("size", ["8k", "12k"])  # full in lift.txt, full in lift.png (measured)
+def test_a_full_disk_leaves_no_half_written_whatif_output(tmp_path, capsys, size):
+    with _tmpfs(tmp_path / "disk", size) as disk:
+        code = main(["whatif", "lift", "--pressures", "100", "--out", str(disk / "out")])
+        left = _after_disk_full(capsys, disk / "out", code)
+        assert left in ([".twin.lock"], [".twin.lock", "lift.csv", "lift.png", "lift.txt"]), left
+        assert all((disk / "out" / name).stat().st_size > 0 for name in left)
+
+
+def test_a_disk_that_fills_while_a_table_is_written_leaves_no_temporary(tmp_path, capsys, monkeypatch):
+    """A whole sweep, then its results.csv fills the disk after the header: exit 2, and neither a half-written
+    results.csv nor its temporary is left (the store keeps the finished scenarios)."""
+    import twin.batch.tables
+
+    cell = twin.batch.tables._cell
+
+    def until_full(value):
+        if isinstance(value, str) and value.startswith("ffpva"):  # the first row's key: the header is out
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return cell(value)
+
+    monkeypatch.setattr(twin.batch.tables, "_cell", until_full)
+    out = tmp_path / "sweep"
+    code = main(["sweep", "--controller", "ffpva", "--trajectory", "4", "--seed", "0", "--workers", "1",
+                 "--out", str(out)])
+    assert _after_disk_full(capsys, out, code) == [".twin.lock", "results.sqlite"]
+
+
+def test_a_full_disk_while_a_sweep_stores_its_rows_is_a_one_line_error(tmp_path, capsys, monkeypatch):
+    """SQLite's own answer to a full disk, injected where the store writes its rows."""
+    connect = sqlite3.connect
+
+    class FullDisk:
+        def __init__(self, db):
+            self._db = db
+
+        def __getattr__(self, name):
+            return getattr(self._db, name)
+
+        def __enter__(self):
+            return self._db.__enter__()
+
+        def __exit__(self, *exc):
+            return self._db.__exit__(*exc)
+
+        def executemany(self, *args):
+            raise sqlite3.OperationalError("database or disk is full")
+
+    monkeypatch.setattr(sqlite3, "connect", lambda *args, **kwargs: FullDisk(connect(*args, **kwargs)))
+    out = tmp_path / "sweep"
+    code = main(["sweep", "--trajectory", "4", "--seed", "0", "--workers", "1", "--out", str(out)])
+    assert code == 2
+    err = capsys.readouterr().err
+    errors = [line for line in err.splitlines() if line.startswith("twin: error:")]
+    assert len(errors) == 1 and err.rstrip().endswith(errors[0]) and "Traceback" not in err, err  # after the bar
+    assert "cannot write the results store" in errors[0] and "full" in errors[0]
+    assert not (out / "results.csv").exists()
 
 
 def test_tables_read_cleanly_in_a_spreadsheet(tmp_path):

@@ -10,8 +10,11 @@ import pytest
 from twin.exceptions import InvalidScenario
 from twin.experiments import calibrate
 from twin.experiments.calibrate import CellResult, cost, values_at
-from twin.experiments.reference import (THESIS_EXPERIMENT_RMSE_DEG, THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
-                                        THESIS_ROBUSTNESS_T1_DEG)
+from twin.experiments.reference import (
+    THESIS_EXPERIMENT_RMSE_DEG,
+    THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
+    THESIS_ROBUSTNESS_T1_DEG,
+)
 from twin.physics.valves import ValveModel
 from twin.plants.as_built import CALIBRATION_FILE, FITTED, as_built_plant, calibrated_values, ensemble_values
 
@@ -90,7 +93,10 @@ def test_targets_are_section_8_and_the_chapter_6_t1_cells_each_once_and_no_t3():
 
 def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_the_breakaway_extremes():
     E = calibrate.Evaluation
-    v = lambda f, a=0.01: {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14}
+
+    def v(f, a=0.01):
+        return {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14}
+
     history = [E(v(2.0), 1.00, "scan"), E(v(1.2), 1.04, "profile"), E(v(2.4), 1.05, "profile"),
                E(v(1.8), 1.02, "simplex"), E(v(1.8), 1.02, "simplex"), E(v(2.5), 1.30, "profile"),
                E(v(1.9, 0.02), 1.01, "simplex")]

@@ -62,8 +62,12 @@ class ResultStore:
     def add(self, records: list[dict]) -> None:
         """Persist finished scenarios atomically (all of them or none)."""
         rows = [tuple(json.dumps(r[c]) if c == "warnings" else r[c] for c in COLUMNS) for r in records]
-        with self._db:
-            self._db.executemany(f"INSERT OR REPLACE INTO results VALUES ({', '.join('?' * len(COLUMNS))})", rows)
+        try:
+            with self._db:
+                self._db.executemany(f"INSERT OR REPLACE INTO results VALUES ({', '.join('?' * len(COLUMNS))})",
+                                     rows)
+        except sqlite3.Error as error:  # a full disk, a folder made read-only meanwhile: rolled back
+            raise StoreUnwritable(f"cannot write the results store {self.path}: {error}") from None
 
     def records(self, keys: list[str]) -> list[dict]:
         """The stored rows for ``keys``, in that order (missing keys skipped)."""

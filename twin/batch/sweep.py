@@ -165,8 +165,20 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
 
 
 def _ignore_interrupts() -> None:
-    """In a worker: Ctrl-C is the parent's to handle (it stops the workers itself)."""
+    """In a worker: Ctrl-C is the parent's to handle (it stops the workers itself). A worker also dies
+    with its parent (Linux's parent-death signal): a worker outliving a SIGKILLed sweep would hold the
+    inherited lock on the output folder, and the resume would be refused."""
+    parent = os.getppid()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL(None, use_errno=True)
+        libc.prctl(1, signal.SIGKILL, 0, 0, 0)  # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):  # not Linux: the parent's own handlers still stop the workers
+        return
+    if os.getppid() != parent:  # the parent died before the signal was set
+        os._exit(1)
 
 
 def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,

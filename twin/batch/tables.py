@@ -33,12 +33,16 @@ def _cell(value):
 def write_csv(rows: Sequence[dict], columns: Sequence[str], path: pathlib.Path) -> None:
     """``rows`` as CSV with ``columns`` (lists joined with ';', None empty), written whole or not at all."""
     tmp = path.with_suffix(path.suffix + ".tmp")
-    with open(tmp, "w", newline="") as handle:
-        writer = csv.DictWriter(handle, fieldnames=list(columns), extrasaction="ignore")
-        writer.writeheader()
-        for row in rows:
-            writer.writerow({c: _cell(row[c]) for c in columns})
-    tmp.replace(path)  # never a half-written file
+    try:
+        with open(tmp, "w", newline="") as handle:
+            writer = csv.DictWriter(handle, fieldnames=list(columns), extrasaction="ignore")
+            writer.writeheader()
+            for row in rows:
+                writer.writerow({c: _cell(row[c]) for c in columns})
+        tmp.replace(path)  # never a half-written file
+    except BaseException:
+        tmp.unlink(missing_ok=True)  # nor its temporary (a full disk, an interrupt)
+        raise
 
 
 def write_results(rows: Sequence[dict], out: pathlib.Path) -> None:

@@ -9,12 +9,16 @@ from twin.experiments import arguments
 
 
 def _cmd_bench(args: argparse.Namespace) -> int:
-    from twin.experiments.bench import measure
+    from tqdm import tqdm
 
-    def progress(stage: str) -> None:
-        print(f"bench: {stage} ...", file=sys.stderr, flush=True)
+    from twin.experiments.bench import measure, planned_seconds
 
-    for line in measure(batch_size=args.batch, workers=args.workers, progress=progress).lines():
+    # the bar counts simulated scenario-seconds out of those planned; its label names the stage
+    total = planned_seconds(batch_size=args.batch, workers=args.workers)
+    with tqdm(total=total, desc="bench", unit=" simulated s", unit_scale=True, file=sys.stderr,
+              dynamic_ncols=True) as bar:
+        bench = measure(batch_size=args.batch, workers=args.workers, bar=bar)
+    for line in bench.lines():
         print(line)
     return 0
 

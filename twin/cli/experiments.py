@@ -27,7 +27,7 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
             print(f"interrupted: finished runs are kept in {args.out / 'results.sqlite'}; "
                   "run the same command again to finish the rest", file=sys.stderr)
             return 130
-        paths = experiment.outputs(outcome, args.out)
+        paths = experiment.publish(outcome, args.out)  # all of them or none
     print(outcome.answer)
     print(f"wrote {', '.join(str(p) for p in paths)}")
     return 1 if outcome.failed else 0

@@ -21,7 +21,10 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import pathlib
+import shutil
+import tempfile
 from typing import Any, ClassVar
 
 from twin.batch.tables import write_csv
@@ -70,3 +73,17 @@ class Experiment:
         png = out / f"{self.name}.png"
         self.plot(outcome, png)
         return paths + [png]
+
+    def publish(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
+        """:meth:`outputs` all or nothing: written into a staging folder inside ``out``, then each file
+        renamed into ``out`` (renames need no space); if any write fails (a full disk, an interrupt), the
+        staging folder goes and ``out`` keeps what it had. The final paths, in :meth:`outputs`'s order."""
+        staging = pathlib.Path(tempfile.mkdtemp(prefix=f".{self.name}-", dir=out))
+        try:
+            staged = self.outputs(outcome, staging)
+            final = [out / path.relative_to(staging) for path in staged]
+            for path, target in zip(staged, final, strict=True):
+                os.replace(path, target)
+            return final
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)

@@ -57,72 +57,116 @@ class Bench:
         ]
 
 
-def _fastest(work: Callable[[], object], repeats: int) -> float:
+BARE_REPEATS = 5  # of every bare loop
+BARE_LENGTH = 10  # a bare loop simulates this many times the run's duration
+
+
+def _fastest(work: Callable[[], object], repeats: int, done: Callable[[], None] | None = None) -> float:
     """Wall seconds of the fastest of ``repeats`` calls of ``work``: on a shared machine the minimum is
-    the cost, the rest is other tenants."""
+    the cost, the rest is other tenants. ``done()`` after each call, outside its timing."""
     walls = []
     for _ in range(repeats):
         start = time.perf_counter()
         work()
         walls.append(time.perf_counter() - start)
+        if done is not None:
+            done()
     return min(walls)
 
 
-def _bare_step_cost(seconds: float) -> float:
+def _bare_step_cost(seconds: float, done: Callable[[], None] | None = None) -> float:
     """A bare ``mj_step`` loop of the joint at rest, per simulated second."""
     joint = compile_joint()
     steps = int(round(seconds / joint.timestep))
     data = mujoco.MjData(joint.model)  # the joint stays at rest: every repeat steps the same state
-    return _fastest(lambda: mujoco.mj_step(joint.model, data, nstep=steps), 5) / seconds
+    return _fastest(lambda: mujoco.mj_step(joint.model, data, nstep=steps), BARE_REPEATS, done) / seconds
 
 
-def _sweep_walls(workers: int) -> tuple[dict, float]:
-    """The 360-scenario thesis grid (3 controllers x 4 trajectories x 3 payloads x 2 orientations x 5 seeds),
-    timed end to end (workers start, run, store) with 1 worker and with ``workers``."""
-    import tempfile
-
+def _sweep_grid() -> tuple[list, float]:
+    """The 360-scenario thesis grid (3 controllers x 4 trajectories x 3 payloads x 2 orientations x 5 seeds)
+    and the scenario-seconds it simulates."""
     from twin.batch.grid import expand
-    from twin.batch.sweep import run_sweep
     from twin.physics.trajectories import trajectory
 
     points = expand({"controller": ["pva", "ffpva", "smc"], "trajectory": [1, 2, 3, 4], "payload": [0.0, 6.5, 13.5],
                      "orientation": ["horizontal", "vertical"], "seed": list(range(5))})
-    scenario_seconds = sum(trajectory(p.trajectory, spur_radius=1.0).duration for p in points)
+    return points, sum(trajectory(p.trajectory, spur_radius=1.0).duration for p in points)
+
+
+def _sweep_walls(workers: int, progress: Callable[[int], None] | None = None) -> tuple[dict, float]:
+    """The grid of :func:`_sweep_grid` timed end to end (workers start, run, store) with 1 worker and with
+    ``workers``; ``progress(n)`` as ``run_sweep`` reports finished scenarios (its own sweeps do the same)."""
+    import tempfile
+
+    from twin.batch.sweep import run_sweep
+
+    points, scenario_seconds = _sweep_grid()
+
     def sweep(count: int) -> None:
         with tempfile.TemporaryDirectory() as out:
-            run_sweep(points, out=pathlib.Path(out), workers=count)
+            run_sweep(points, out=pathlib.Path(out), workers=count, progress=progress)
 
     return {count: _fastest(functools.partial(sweep, count), REPEATS) for count in sorted({1, workers})}, scenario_seconds
 
 
-def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None,
-            progress: Callable[[str], None] | None = None) -> Bench:
+def planned_seconds(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None) -> float:
+    """The scenario-seconds :func:`measure` simulates, counted before it runs: one warm-up run, five bare
+    loops, and every repeat of the single run, the batch, the environment and the sweeps."""
+    from twin.physics.trajectories import trajectory as reference
+
+    duration = reference(trajectory, spur_radius=1.0).duration
+    sweeps = len({1, workers or os.cpu_count() or 1})
+    return (duration + 5 * BARE_REPEATS * BARE_LENGTH * duration  # five bare loops, one per stage and one last
+            + REPEATS * duration * (1 + batch_size + 1) + REPEATS * sweeps * _sweep_grid()[1])
+
+
+def measure(*, batch_size: int = 100, trajectory: int = 1, workers: int | None = None, bar=None) -> Bench:
     """Each measurement is preceded and the whole followed by a bare loop; the bare cost is the fastest
-    of them all, so a quiet spell during one bare loop cannot flatter the twin. ``progress(stage)``
-    names each of the four stages as it starts."""
-    say = progress or (lambda stage: None)
-    say("[1/4] one run and bare mj_step")
+    of them all, so a quiet spell during one bare loop cannot flatter the twin. ``bar`` (a tqdm bar,
+    optional) is given :func:`planned_seconds` before anything runs, counts the scenario-seconds simulated
+    as each timed call ends (outside its timing; a sweep's as its scenarios finish) and is labelled with
+    each of the four stages as it starts."""
+    from twin.physics.trajectories import trajectory as reference
+
+    run_seconds = reference(trajectory, spur_radius=1.0).duration  # the bar's units; timings use the run's own
+    sweep_points, sweep_seconds = _sweep_grid()
+
+    def stage(label: str) -> None:
+        if bar is not None:
+            bar.set_description(f"bench {label}")
+
+    def done(scenario_seconds: float) -> Callable[[], None]:
+        """What each timed call of ``scenario_seconds`` reports when it ends."""
+        return lambda: None if bar is None else bar.update(scenario_seconds)
+
+    if bar is not None:
+        bar.reset(total=planned_seconds(batch_size=batch_size, trajectory=trajectory, workers=workers))
+    stage("[1/4] one run and bare mj_step")
     scenario = Scenario("ffpva", trajectory)
     single = run_many([scenario])[0]  # also warms caches (model compile, imports, kernels)
+    done(run_seconds)()
     duration = float(len(single.trace.time)) * 1e-3
-    bare = [_bare_step_cost(duration * 10)]
-    twin_single = _fastest(lambda: run_many([scenario]), REPEATS) / duration
-    bare.append(_bare_step_cost(duration * 10))
-    say(f"[2/4] a batch of {batch_size} runs")
+    bare_done = done(BARE_LENGTH * run_seconds)
+    bare = [_bare_step_cost(duration * BARE_LENGTH, bare_done)]
+    twin_single = _fastest(lambda: run_many([scenario]), REPEATS, done(run_seconds)) / duration
+    bare.append(_bare_step_cost(duration * BARE_LENGTH, bare_done))
+    stage(f"[2/4] a batch of {batch_size} runs")
     batch = [Scenario("ffpva", trajectory, seed=s) for s in range(batch_size)]
-    twin_batch = _fastest(lambda: run_many(batch, nthread=1), REPEATS) / (duration * batch_size)  # one core, as the bare loop
-    bare.append(_bare_step_cost(duration * 10))
-    say("[3/4] the dm_control environment")
-    env_single = _env_cost(trajectory, duration)
-    bare.append(_bare_step_cost(duration * 10))
-    say("[4/4] the sweep on 1 and all workers")
-    walls, scenario_seconds = _sweep_walls(workers or os.cpu_count() or 1)
-    bare.append(_bare_step_cost(duration * 10))
+    twin_batch = _fastest(lambda: run_many(batch, nthread=1), REPEATS,  # one core, as the bare loop
+                          done(batch_size * run_seconds)) / (duration * batch_size)
+    bare.append(_bare_step_cost(duration * BARE_LENGTH, bare_done))
+    stage("[3/4] the dm_control environment")
+    env_single = _env_cost(trajectory, duration, done(run_seconds))
+    bare.append(_bare_step_cost(duration * BARE_LENGTH, bare_done))
+    stage("[4/4] the sweep on 1 and all workers")
+    walls, scenario_seconds = _sweep_walls(workers or os.cpu_count() or 1, None if bar is None else (
+        lambda n: bar.update(n * sweep_seconds / len(sweep_points))))
+    bare.append(_bare_step_cost(duration * BARE_LENGTH, bare_done))
     return Bench(bare_step=min(bare), twin_single=twin_single, twin_batch=twin_batch, batch_size=batch_size,
                  env_single=env_single, sweep_walls=walls, sweep_scenario_seconds=scenario_seconds)
 
 
-def _env_cost(trajectory: int, duration: float) -> float:
+def _env_cost(trajectory: int, duration: float, done: Callable[[], None] | None = None) -> float:
     """One FF + PVA episode through twin.envs.environment, the same scenario as the single twin run."""
     from controllers import make_controller
     from controllers.feedforward import NominalModel
@@ -138,4 +182,4 @@ def _env_cost(trajectory: int, duration: float) -> float:
         while not timestep.last():
             timestep = environment.step(policy(timestep))
 
-    return _fastest(episode, REPEATS) / duration
+    return _fastest(episode, REPEATS, done) / duration

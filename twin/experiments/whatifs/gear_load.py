@@ -56,7 +56,9 @@ def _exceeding(rows: Sequence[dict], window: float) -> int:
 
 
 def gear_load_study(*, pressures_kpa: Sequence[float] = (300.0, 700.0), payloads_g: Sequence[float] = (0.0, 13.5),
-                    plant_name: str = "thesis") -> Outcome:
+                    plant_name: str = "thesis", bar=None) -> Outcome:
+    """Every controller on every trajectory, vertical, at each payload and supply pressure, one batch;
+    ``bar`` (a tqdm bar, optional) is given the number of scenarios before they run, then counts them."""
     from twin.envs.runner import run_many
 
     scenarios = [Scenario(c, t, payload=m / 1e3, orientation=Orientation.VERTICAL, plant=plant_name,
@@ -65,7 +67,10 @@ def gear_load_study(*, pressures_kpa: Sequence[float] = (300.0, 700.0), payloads
     preset = plant(plant_name)
     gears = preset.params.gears
     rows = []
-    for r in run_many(scenarios):
+    if bar is not None:
+        bar.reset(total=len(scenarios))
+    for r in run_many(scenarios, progress=None if bar is None else lambda done, ticks: bar.update(
+            len(scenarios) * done // ticks - bar.n)):  # one batch: its scenarios advance together
         tr = r.trace
         speed = np.abs(np.gradient(tr.rack_position, tr.time))
         row = {"controller": r.scenario.controller, "trajectory": r.scenario.trajectory,
@@ -121,8 +126,8 @@ class GearLoadWhatIf(Experiment):
         add_common_arguments(parser, self.default_plant, seeds=False)
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
-        with progress_bar(self.name):
-            return gear_load_study(plant_name=args.plant)
+        with progress_bar(self.name) as bar:
+            return gear_load_study(plant_name=args.plant, bar=bar)
 
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         plot_gear_load(outcome.rows, path)

@@ -23,6 +23,7 @@ from viz.figures import finish, plt
 
 LIFT_SPAN_DEG = (80.0, 100.0)  # the lift must pass the horizontal link position
 THESIS_PAYLOAD = THESIS_PAYLOADS_G[-1] * 1e-3  # kg, the heaviest payload of the robustness study
+PAYLOAD_COLUMN = f"lifts_{THESIS_PAYLOAD * 1e3:g}g"  # true where a run with that payload passed the span
 
 
 def lift_limit_closed_form(params: JointParams, supply_pressure: float) -> float:
@@ -42,16 +43,16 @@ def lift_limit_closed_form(params: JointParams, supply_pressure: float) -> float
     return float(np.min(mass))
 
 
-def _lifts(payloads: np.ndarray, pressures: np.ndarray, plant_name: str) -> np.ndarray:
-    """Simulate each (payload, pressure) from 80 deg (T3's start) with the valves fully open;
-    True where the link passes the end of LIFT_SPAN_DEG within the run."""
+def _lifts(payloads: np.ndarray, pressures: np.ndarray, plant_name: str, progress=None) -> np.ndarray:
+    """Simulate each (payload, pressure) from 80 deg (T3's start) with the valves fully open, one batch
+    (``progress`` as for ``simulate``); True where the link passes the end of LIFT_SPAN_DEG within the run."""
     from controllers.open_loop import OpenLoop
     from twin.sim.simulation import simulate
 
     scenarios = [Scenario(None, 3, payload=float(m), orientation=Orientation.VERTICAL, plant=plant_name,
                           noise=False, supply_pressure=float(p)) for m, p in zip(payloads, pressures, strict=True)]
     opener = OpenLoop(schedule=lambda t: 100.0, tick=plant(plant_name).timestep)
-    results = simulate(scenarios, controllers=[opener] * len(scenarios))
+    results = simulate(scenarios, controllers=[opener] * len(scenarios), progress=progress)
     return np.array([np.degrees(r.trace.angle).max() >= LIFT_SPAN_DEG[1] for r in results])
 
 
@@ -71,32 +72,78 @@ def _lift_at(pressure: float, pressures: np.ndarray, lifted_g: np.ndarray) -> st
     return f"{at} was not studied (pressures {studied} kPa)"
 
 
-def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", tolerance: float = 0.005) -> Outcome:
+def _bisection_steps(closed: np.ndarray, can: np.ndarray, tolerance: float) -> int:
+    """Halvings until every bracket in ``can`` (0 to 1.5 x its closed form + 1 mg) is within ``tolerance``
+    of its closed form: all pressures are bisected together, so the most demanding one sets the count."""
+    steps = 0
+    for c in closed[can]:
+        width, k = 1.5 * c + 1e-3, 0
+        while width > tolerance * abs(c):
+            width, k = width / 2, k + 1
+        steps = max(steps, k)
+    return steps
+
+
+def _count(bar, count: int):
+    """``simulate``'s ``progress(done_ticks, total_ticks)`` for one batch of ``count`` scenarios, shown on
+    ``bar`` in scenarios (the batch's scenarios advance together)."""
+    start = bar.n
+    return lambda done, ticks: bar.update(start + count * done // ticks - bar.n)
+
+
+def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", tolerance: float = 0.005,
+               bar=None) -> Outcome:
+    """``bar`` (a tqdm bar, optional) is given the number of scenarios before any runs, then counts them."""
     params = plant(plant_name).params
     pressures = np.unique(np.array(pressures_kpa, dtype=float)) * 1e3  # sorted, so rows and answer run upwards
+    n = len(pressures)
     closed = np.array([lift_limit_closed_form(params, p) for p in pressures])
-    bare_link_lifts = _lifts(np.zeros_like(pressures), pressures, plant_name)
+    if bar is not None:  # the bare link and the thesis payload at every pressure, then the bisection (at most)
+        bar.reset(total=2 * n + int(np.sum(closed > 0)) * _bisection_steps(closed, closed > 0, tolerance))
+
+    def lifts(payloads: np.ndarray, at: np.ndarray) -> np.ndarray:
+        return _lifts(payloads, at, plant_name, progress=None if bar is None else _count(bar, len(at)))
+
+    first = lifts(np.concatenate([np.zeros(n), np.full(n, THESIS_PAYLOAD)]), np.concatenate([pressures, pressures]))
+    bare_link_lifts, payload_lifts = first[:n], first[n:]  # the payload itself, not read off the bisection
     can = bare_link_lifts & (closed > 0)
+    steps = _bisection_steps(closed, can, tolerance)
+    if bar is not None:  # exact now that the bare link's runs say which pressures lift it at all
+        bar.total = 2 * n + int(np.sum(can)) * steps
+        bar.refresh()
     low, high = np.zeros_like(closed), np.where(can, 1.5 * closed + 1e-3, 0.0)
-    while np.any(can & (high - low > tolerance * np.abs(closed))):  # bisection, all pressures in one batch
+    for _ in range(steps):  # bisection, all pressures in one batch
         middle = (low + high) / 2
-        lifted = _lifts(middle[can], pressures[can], plant_name)
+        lifted = lifts(middle[can], pressures[can])
         low[can], high[can] = np.where(lifted, middle[can], low[can]), np.where(lifted, high[can], middle[can])
     simulated = np.where(bare_link_lifts, (low + high) / 2, np.nan)
     rows = [{"supply_kpa": p / 1e3, "lift_closed_form_g": max(c, 0.0) * 1e3,
              "lift_simulated_g": s * 1e3 if np.isfinite(s) else 0.0,
-             "difference_pct": 100 * (s - c) / c if c > 0 and np.isfinite(s) else float("nan")}
-            for p, c, s in zip(pressures, closed, simulated, strict=True)]
-    lifted_g = np.array([r["lift_simulated_g"] for r in rows])
-    needed = pressures[lifted_g >= THESIS_PAYLOAD * 1e3]
+             "difference_pct": 100 * (s - c) / c if c > 0 and np.isfinite(s) else float("nan"),
+             PAYLOAD_COLUMN: bool(lifted)}
+            for p, c, s, lifted in zip(pressures, closed, simulated, payload_lifts, strict=True)]
     differences = [abs(r["difference_pct"]) for r in rows if np.isfinite(r["difference_pct"])]
     answer = (f"Vertical, valves fully open, through {LIFT_SPAN_DEG[0]:g}-{LIFT_SPAN_DEG[1]:g} deg: "
-              f"{_lift_at(NOMINAL_PARAMS.supply.pressure, pressures, lifted_g)}; "
-              + (f"13.5 g needs {needed.min() / 1e3:g} kPa or more of those tried. " if needed.size
-                 else "13.5 g cannot be lifted at any pressure tried. ")
+              f"{_lift_at(NOMINAL_PARAMS.supply.pressure, pressures, np.array([r['lift_simulated_g'] for r in rows]))}; "
+              f"{_payload_needs(pressures, payload_lifts)} "
               + (f"Simulation and torque balance agree within {max(differences):.1f} %. " if differences else "")
               + "Holding needs no pressure in this plant: sealed chambers lock the joint.")
     return Outcome(rows, answer)
+
+
+def _payload_needs(pressures: np.ndarray, lifted: np.ndarray) -> str:
+    """The lowest of the sorted ``pressures`` (Pa) at which the thesis payload was lifted, from the runs
+    of that payload itself (``lifted``), with the tried pressure below it and any higher one that failed."""
+    grams = f"{THESIS_PAYLOAD * 1e3:g} g"
+    if not np.any(lifted):
+        return f"{grams} is not lifted at any pressure tried (up to {pressures[-1] / 1e3:g} kPa)."
+    first = int(np.argmax(lifted))
+    said = f"{grams} is lifted from {pressures[first] / 1e3:g} kPa, the lowest pressure tried that lifts it"
+    said += f" ({pressures[first - 1] / 1e3:g} kPa does not)" if first > 0 else " (nothing lower was tried)"
+    failed = pressures[first:][~lifted[first:]]
+    if failed.size:
+        said += f", yet not at {', '.join(f'{p / 1e3:g}' for p in failed)} kPa"
+    return said + "."
 
 
 def plot_lift(rows: Sequence[dict], path: pathlib.Path) -> None:
@@ -121,8 +168,8 @@ class LiftWhatIf(Experiment):
         args.pressure_values = list_flag(args, "--pressures", "pressures", "supply_kpa")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
-        with progress_bar(self.name):
-            return lift_study(pressures_kpa=args.pressure_values, plant_name=args.plant)
+        with progress_bar(self.name) as bar:
+            return lift_study(pressures_kpa=args.pressure_values, plant_name=args.plant, bar=bar)
 
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         plot_lift(outcome.rows, path)

@@ -21,10 +21,14 @@ FOLLOW_LIMIT_DEG = 10.0  # max |error| beyond which the joint "no longer follows
 
 
 def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory: int = 1, seeds: int = 3,
-                  plant_name: str = "thesis", workers: int | None = None, progress=None) -> Outcome:
+                  plant_name: str = "thesis", workers: int | None = None, bar=None) -> Outcome:
+    """``bar`` (a tqdm bar, optional) is given the number of scenarios before they run, then counts them
+    (a resumed study counts the ones already in ``out`` at once)."""
     points = expand({"controller": ["ffpva", "smc"], "trajectory": [trajectory], "payload": list(payloads_g),
                      "orientation": ["horizontal", "vertical"], "plant": [plant_name], "seed": list(range(seeds))})
-    records = run_sweep(points, out=out, workers=workers, progress=progress).records
+    if bar is not None:
+        bar.reset(total=len(points))
+    records = run_sweep(points, out=out, workers=workers, progress=None if bar is None else bar.update).records
     rows = summarise(records)
     lines = []
     for controller in ("ffpva", "smc"):
@@ -61,7 +65,7 @@ class PayloadWhatIf(Experiment):
         store.mkdir(exist_ok=True)
         with progress_bar(self.name) as bar:
             return payload_study(out=store, payloads_g=args.payload_values, trajectory=args.trajectory,
-                                 seeds=args.seeds, plant_name=args.plant, workers=args.workers, progress=bar.update)
+                                 seeds=args.seeds, plant_name=args.plant, workers=args.workers, bar=bar)
 
     def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
         """``payload.csv`` and ``payload.txt``, and the sweep store the runs are kept in (resumable)."""

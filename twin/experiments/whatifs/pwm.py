@@ -38,10 +38,11 @@ def _pwm_setup(base: Plant) -> str:
 
 
 def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = (1, 3), seeds: int = 3,
-              plant_name: str = "thesis-pwm", progress=None) -> Outcome:
+              plant_name: str = "thesis-pwm", bar=None) -> Outcome:
     """RMSE against the valves' PWM period, with the controllers' periods fixed at the base plant's
     (16 ms): one batch, controllers shared across scenarios, built from the base plant rather than from
-    each scenario (``twin.envs.runner`` would make the controllers follow the valves' period)."""
+    each scenario (``twin.envs.runner`` would make the controllers follow the valves' period). ``bar``
+    (a tqdm bar, optional) is given the number of scenarios before they run, then counts them."""
     from controllers import make_controller
     from twin.envs.runner import nominal_model
     from twin.sim.simulation import simulate
@@ -51,8 +52,11 @@ def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = (1, 
              for c in MODEL_BASED_CONTROLLERS for t in trajectories for s in range(seeds) for ms in periods_ms]
     controllers = {c: make_controller(c, nominal=nominal_model(base), gain_set=base.gain_set, tick=base.timestep)
                    for c in MODEL_BASED_CONTROLLERS}
+    if bar is not None:
+        bar.reset(total=len(cases))
     results = simulate([s for s, _ in cases], controllers=[controllers[s.controller] for s, _ in cases],
-                       progress=progress)
+                       progress=None if bar is None else lambda done, ticks: bar.update(
+                           len(cases) * done // ticks - bar.n))  # one batch: its scenarios advance together
     records = [{**report.summary(r), "pwm_period_ms": ms, "status": "failed" if r.warnings else "ok"}
                for r, (_, ms) in zip(results, cases, strict=True)]
     rows = summarise(records)
@@ -95,8 +99,8 @@ class PwmWhatIf(Experiment):
         args.period_values = list_flag(args, "--periods", "periods", "pwm_period_ms")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
-        with progress_bar(self.name):
-            return pwm_study(periods_ms=args.period_values, seeds=args.seeds, plant_name=args.plant)
+        with progress_bar(self.name) as bar:
+            return pwm_study(periods_ms=args.period_values, seeds=args.seeds, plant_name=args.plant, bar=bar)
 
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         plot_pwm(outcome.rows, path)

@@ -36,14 +36,18 @@ def supply_variants(base: Plant) -> dict[str, Plant]:
 
 
 def supply_study(*, trajectories: Sequence[int] = (1, 3), seeds: int = 3, plant_name: str = "as-built",
-                 progress=None) -> Outcome:
-    """FF + PVA and sliding mode on ``trajectories`` with each supply model, ``seeds`` runs each, one batch."""
+                 bar=None) -> Outcome:
+    """FF + PVA and sliding mode on ``trajectories`` with each supply model, ``seeds`` runs each, one batch;
+    ``bar`` (a tqdm bar, optional) is given the number of scenarios before they run, then counts them."""
     from twin.envs.runner import run_many
 
     variants = supply_variants(plant(plant_name))
     cases = [(Scenario(c, t, plant=variants[m], seed=s), m)
              for m in SUPPLY_MODELS for c in MODEL_BASED_CONTROLLERS for t in trajectories for s in range(seeds)]
-    results = run_many([s for s, _ in cases], progress=progress)
+    if bar is not None:
+        bar.reset(total=len(cases))
+    results = run_many([s for s, _ in cases], progress=None if bar is None else lambda done, ticks: bar.update(
+        len(cases) * done // ticks - bar.n))  # one batch: its scenarios advance together
     records = [{**report.summary(r), "pwm_period_ms": None, "status": "failed" if r.warnings else "ok"}
                for r in results]
     model_of = {variant.name: model for model, variant in variants.items()}
@@ -90,8 +94,8 @@ class SupplyWhatIf(Experiment):
         supply_variants(plant(args.plant))  # a plant whose supply cannot sag is refused
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
-        with progress_bar(self.name):
-            return supply_study(seeds=args.seeds, plant_name=args.plant)
+        with progress_bar(self.name) as bar:
+            return supply_study(seeds=args.seeds, plant_name=args.plant, bar=bar)
 
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         plot_supply(outcome.rows, path)
