@@ -39,6 +39,7 @@ from twin.experiments import calibrate
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import THESIS_PAYLOADS_G, THESIS_SIMULATED_RMSE_DEG
 from twin.sim.metrics import spread
+from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import plt
 
 SEEDS = (0, 1, 2, 3, 4)  # the thesis's five runs
@@ -53,7 +54,7 @@ VALIDATION_COLUMNS = ("source", "controller", "trajectory", "payload_g", "orient
                       "twin_mean", "twin_std", "ratio", "within_tolerance")
 PREDICTION_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "twin_mean", "band_p10", "band_p50",
                       "band_p90", "stalled_runs")
-LABELS = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
+LABELS = CONTROLLER_LABELS
 
 
 def _row(source, controller, trajectory, payload_g, orientation, plant, measured, twin_mean, twin_std,
