@@ -83,7 +83,10 @@ class Experiment:
             staged = self.outputs(outcome, staging)
             final = [out / path.relative_to(staging) for path in staged]
             for path, target in zip(staged, final, strict=True):
-                os.replace(path, target)
+                if path.exists():
+                    os.replace(path, target)
+                elif not target.exists():  # listed but neither staged nor in out (a store the run kept there)
+                    raise FileNotFoundError(f"{self.name} listed {target.name} but did not write it")
             return final
         finally:
             shutil.rmtree(staging, ignore_errors=True)

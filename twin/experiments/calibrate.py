@@ -107,6 +107,7 @@ def _targets() -> tuple[Target, ...]:
 
 TARGETS = _targets()
 CELLS = tuple(t.key for t in TARGETS)  # (controller, trajectory, payload g, orientation)
+EXPERIMENT_CELLS = tuple(t.key for t in TARGETS if t.source == "chapter 5 experiment")  # §8's table alone
 _TARGET = {t.key: t for t in TARGETS}
 
 

@@ -20,7 +20,7 @@ import numpy as np
 from twin.batch.tables import write_csv
 from twin.experiments.arguments import positive_int
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.calibrate import CHECK_SEEDS, Evaluator, cell_rows
+from twin.experiments.calibrate import CHECK_SEEDS, EXPERIMENT_CELLS, Evaluator, cell_rows
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
 from twin.plants.as_built import EFFECTS, calibrated_values
 from twin.sim.scenario import CONTROLLER_LABELS
@@ -49,7 +49,7 @@ def ablation_study(*, seeds: Sequence[int] = CHECK_SEEDS, workers: int = 2,
                    progress: Callable[[int, int, str], None] | None = None) -> Ablation:
     """``progress(done, total, variant)`` after each variant."""
     values = calibrated_values()
-    evaluator = Evaluator(seeds=seeds, workers=workers)
+    evaluator = Evaluator(seeds=seeds, workers=workers, cells=EXPERIMENT_CELLS)
     rows = []
     try:
         for done, (label, off) in enumerate(variants(), start=1):
