@@ -92,7 +92,7 @@ def _fake(ratio_13_5: float, lag_within: bool, stalled: int) -> validate.Validat
     prediction = [{"controller": "smc", "trajectory": 3, "payload_g": 13.5, "orientation": "vertical",
                    "twin_mean": 2.9, "band_p10": 2.8, "band_p50": 2.9, "band_p90": 3.1, "stalled_runs": stalled}]
     detail = {"members": [{"stiction": 1.0}, {"stiction": 2.2}], "runs": 10, "per_member": [[2.8], [3.1]]}
-    return validate.Validation(rows=rows, prediction=prediction, prediction_detail=detail, openloop=None,
+    return validate.Validation(rows=rows, prediction=prediction, prediction_detail=detail,
                                failed=0, stalled={("smc", 1, 13.5, "vertical"): 0})
 
 

@@ -74,19 +74,21 @@ class Experiment:
         self.plot(outcome, png)
         return paths + [png]
 
+    def kept(self, out: pathlib.Path) -> list[pathlib.Path]:
+        """What :meth:`run` itself keeps in ``out`` to list among the files written (a resumable store)."""
+        return []
+
     def publish(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
         """:meth:`outputs` all or nothing: written into a staging folder inside ``out``, then each file
         renamed into ``out`` (renames need no space); if any write fails (a full disk, an interrupt), the
-        staging folder goes and ``out`` keeps what it had. The final paths, in :meth:`outputs`'s order."""
+        staging folder goes and ``out`` keeps what it had. The final paths, in :meth:`outputs`'s order,
+        then :meth:`kept`."""
         staging = pathlib.Path(tempfile.mkdtemp(prefix=f".{self.name}-", dir=out))
         try:
             staged = self.outputs(outcome, staging)
             final = [out / path.relative_to(staging) for path in staged]
             for path, target in zip(staged, final, strict=True):
-                if path.exists():
-                    os.replace(path, target)
-                elif not target.exists():  # listed but neither staged nor in out (a store the run kept there)
-                    raise FileNotFoundError(f"{self.name} listed {target.name} but did not write it")
-            return final
+                os.replace(path, target)
+            return final + self.kept(out)
         finally:
             shutil.rmtree(staging, ignore_errors=True)

@@ -108,7 +108,7 @@ def _targets() -> tuple[Target, ...]:
 TARGETS = _targets()
 CELLS = tuple(t.key for t in TARGETS)  # (controller, trajectory, payload g, orientation)
 EXPERIMENT_CELLS = tuple(t.key for t in TARGETS if t.source == "chapter 5 experiment")  # §8's table alone
-_TARGET = {t.key: t for t in TARGETS}
+TARGET_OF = {t.key: t for t in TARGETS}  # cell key -> its Target
 
 
 @dataclasses.dataclass(frozen=True)
@@ -181,11 +181,12 @@ class Evaluator:
         if self.pool is not None:
             self.pool.shutdown()
 
-    def cells(self, values: dict[str, float], *, without: Sequence[str] = (),
-              seeds: Sequence[int] | None = None) -> list[CellResult]:
-        """The cells with the as-built plant at ``values`` (minus the effects in ``without``), on this
-        evaluator's seeds or on ``seeds``."""
-        jobs = [(*key, s) for key in self.keys for s in (self.seeds if seeds is None else seeds)]
+    def cells(self, values: dict[str, float], *, without: Sequence[str] = (), seeds: Sequence[int] | None = None,
+              keys: Sequence[tuple] | None = None) -> list[CellResult]:
+        """The cells (this evaluator's, or ``keys``) with the as-built plant at ``values`` (minus the effects
+        in ``without``), on this evaluator's seeds or on ``seeds``."""
+        keys = self.keys if keys is None else tuple(keys)
+        jobs = [(*key, s) for key in keys for s in (self.seeds if seeds is None else seeds)]
         # Interleave so every worker gets a like mix of long and short runs.
         shares = [share for share in (jobs[i::self.workers] for i in range(self.workers)) if share]
         off = tuple(without)
@@ -202,7 +203,7 @@ class Evaluator:
                            failed_seeds=tuple(seed for seed, _, _, f, _ in found[key] if f),
                            seeds=tuple(seed for seed, *_ in found[key]), payload_g=key[2], orientation=key[3],
                            max_error_deg=tuple(m for *_, m in found[key]))
-                for key in self.keys]
+                for key in keys]
 
 
 def _cells_of(cells: Sequence[CellResult], wanted: Sequence[int]) -> list[CellResult]:
@@ -226,7 +227,7 @@ def residuals(cells: Sequence[CellResult]) -> list[float]:
     """The fit's residuals (see the module docstring): one per cell, then one per T1 steady-error range."""
     rmse, sse = [], []
     for cell in cells:
-        target = _TARGET[cell.key]
+        target = TARGET_OF[cell.key]
         rmse.append(math.log(max(cell.mean_rmse, 1e-6) / target.rmse_deg))
         if target.sse_range_deg is not None:
             sse.append(math.sqrt(SSE_WEIGHT) * math.log(max(cell.sse_range, 1e-3) / target.sse_range_deg))
@@ -269,8 +270,13 @@ class Calibration:
 
     @property
     def noise(self) -> float:
-        """The seed-to-seed noise of the best cost: the sample std of :attr:`noise_costs` (0 from one)."""
-        return spread(self.noise_costs).std if len(self.noise_costs) > 1 else 0.0
+        """The seed-to-seed noise of the best cost (:func:`cost_noise` of :attr:`noise_costs`)."""
+        return cost_noise(self.noise_costs)
+
+
+def cost_noise(costs: Sequence[float]) -> float:
+    """The seed-to-seed noise of a cost: the sample std of its values on disjoint seed sets (0 from one)."""
+    return spread(costs).std if len(costs) > 1 else 0.0
 
 
 def choose_ensemble(evaluations: Sequence[Evaluation], best: Evaluation, noise: float,
@@ -308,73 +314,69 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
     started = time.perf_counter()
     planned = scan_points + 1 + simplex_evaluations + profile_points + len(noise_seed_sets)
     history: list[Evaluation] = []
-    seen: dict[tuple[float, ...], tuple[float, list[CellResult]]] = {}
+    seen: dict[tuple[float, ...], tuple[Evaluation, list[CellResult]]] = {}
     evaluator = Evaluator(seeds=fit_seeds, workers=workers)
-    stage = "scan"
+    stage, done, budget = "scan", 0, math.inf  # budget: evaluations allowed (the simplex's, while it runs)
 
     def report(c: float, values: dict) -> None:
+        nonlocal done
+        done += 1
         if progress is not None:
-            progress(len(history) + extra[0], planned, stage, c, values)
-
-    extra = [0]
-    budget = [math.inf]  # evaluations allowed so far (the simplex's budget while it runs)
+            progress(done, planned, stage, c, values)
 
     def objective(u: Sequence[float]) -> float:
         key = tuple(float(np.clip(x, 0.0, 1.0)) for x in u)
         if key not in seen:
-            if len(history) >= budget[0]:
+            if len(history) >= budget:
                 raise _BudgetSpent
             values = values_at(key)
             cells = evaluator.cells(values)
-            seen[key] = (cost(cells), cells)
-            history.append(Evaluation(values, seen[key][0], stage))
-            report(seen[key][0], values)
-        return seen[key][0]
+            seen[key] = (Evaluation(values, cost(cells), stage), cells)
+            history.append(seen[key][0])
+            report(seen[key][0].cost, values)
+        return seen[key][0].cost
+
+    def lowest() -> tuple[float, ...]:
+        return min(seen, key=lambda k: seen[k][0].cost)
 
     try:
         design = qmc.Sobol(len(FITTED), scramble=True, seed=SCAN_SEED).random(scan_points) if scan_points else []
         for u in [np.full(len(FITTED), 0.5), *design]:
             objective(u)
-        start = np.array(min(seen, key=lambda k: seen[k][0]))
+        start = np.array(lowest())
         if simplex_evaluations:
             stage = "simplex"
             step = np.where(start > 0.5, -0.15, 0.15)  # into the box
             simplex = np.vstack([start] + [start + step[i] * np.eye(len(FITTED))[i] for i in range(len(FITTED))])
-            budget[0] = len(history) + simplex_evaluations
+            budget = len(history) + simplex_evaluations
             try:
                 minimize(objective, start, method="Nelder-Mead",
                          options={"initial_simplex": simplex, "xatol": 0.01, "fatol": 1e-3})
             except _BudgetSpent:
                 pass
-        best_key = min(seen, key=lambda k: seen[k][0])
-        best_values, best_cost = values_at(best_key), seen[best_key][0]
+            budget = math.inf
+        best_key = lowest()
         stage = "noise"
-        noise_costs = [best_cost]
+        noise_costs = [seen[best_key][0].cost]
         for seeds in noise_seed_sets:
-            c = cost(evaluator.cells(best_values, seeds=seeds))
-            noise_costs.append(c)
-            extra[0] += 1
-            report(c, best_values)
-        budget[0] = math.inf
+            noise_costs.append(cost(evaluator.cells(seen[best_key][0].values, seeds=seeds)))
+            report(noise_costs[-1], seen[best_key][0].values)
         stage = "profile"
         index = [f.name for f in FITTED].index("stiction")
         for x in np.linspace(0.0, 1.0, profile_points) if profile_points else []:
             objective([x if i == index else best_key[i] for i in range(len(FITTED))])
         # A profile point may beat the simplex (the cost is flat along the breakaway, within the noise):
         # the fitted values are the lowest cost evaluated.
-        best_key = min(seen, key=lambda k: seen[k][0])
-        best_values, best_cost = values_at(best_key), seen[best_key][0]
-        fit_cells = seen[best_key][1]
-        check_cells = _cells_of(fit_cells, check_seeds) or (evaluator.cells(best_values, seeds=check_seeds)
+        best, fit_cells = seen[lowest()]
+        check_cells = _cells_of(fit_cells, check_seeds) or (evaluator.cells(best.values, seeds=check_seeds)
                                                             if check_seeds else [])
     finally:
         evaluator.close()
-    best = next(e for e in history if e.values == best_values)
-    noise = spread(noise_costs).std if len(noise_costs) > 1 else 0.0
-    return Calibration(values=best_values, cost=best_cost, evaluations=len(history), history=history,
+    return Calibration(values=best.values, cost=best.cost, evaluations=len(history), history=history,
                        fit_cells=fit_cells, check_cells=check_cells, noise_costs=noise_costs,
-                       ensemble=choose_ensemble(history, best, noise), wall_time=time.perf_counter() - started,
-                       max_evaluations=planned, fit_seeds=tuple(fit_seeds), check_seeds=tuple(check_seeds),
+                       ensemble=choose_ensemble(history, best, cost_noise(noise_costs)),
+                       wall_time=time.perf_counter() - started, max_evaluations=planned,
+                       fit_seeds=tuple(fit_seeds), check_seeds=tuple(check_seeds),
                        noise_seed_sets=tuple(tuple(s) for s in noise_seed_sets))
 
 
@@ -382,7 +384,7 @@ def cell_rows(cells: Sequence[CellResult]) -> list[dict]:
     """One row per cell: the measured RMSE and std, the twin's, their ratio, the T1 SSE ranges."""
     rows = []
     for cell in cells:
-        target = _TARGET[cell.key]
+        target = TARGET_OF[cell.key]
         rows.append({"source": target.source, "controller": cell.controller, "trajectory": cell.trajectory,
                      "payload_g": cell.payload_g, "orientation": cell.orientation,
                      "experiment_rmse_deg": target.rmse_deg, "experiment_std_deg": target.rmse_std_deg,

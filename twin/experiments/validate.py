@@ -54,7 +54,6 @@ VALIDATION_COLUMNS = ("source", "controller", "trajectory", "payload_g", "orient
                       "twin_mean", "twin_std", "ratio", "within_tolerance")
 PREDICTION_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "twin_mean", "band_p10", "band_p50",
                       "band_p90", "stalled_runs")
-LABELS = CONTROLLER_LABELS
 
 
 def _row(source, controller, trajectory, payload_g, orientation, plant, measured, twin_mean, twin_std,
@@ -65,7 +64,12 @@ def _row(source, controller, trajectory, payload_g, orientation, plant, measured
             "twin_std": twin_std, "ratio": ratio, "within_tolerance": bool(within)}
 
 
-def simulation_rows(workers: int) -> list[dict]:
+def stalled_runs(cell: calibrate.CellResult) -> int:
+    """Runs of ``cell`` that did not follow the trajectory (an error above :data:`STALL_ERROR_DEG`)."""
+    return sum(e > STALL_ERROR_DEG for e in cell.max_error_deg)
+
+
+def simulation_rows() -> list[dict]:
     """Chapter 5's simulations on ``thesis``: RMSE per controller and trajectory."""
     from twin.envs.runner import run_many
     from twin.sim.scenario import Scenario
@@ -86,7 +90,7 @@ def measured_rows(cells: Sequence[calibrate.CellResult]) -> list[dict]:
     """Chapter 5's experiments and Chapter 6's T1 cells on ``as-built``: RMSE, then the T1 SSE ranges."""
     rows, sse_rows = [], []
     for cell in cells:
-        target = calibrate._TARGET[cell.key]
+        target = calibrate.TARGET_OF[cell.key]
         s = spread(cell.rmse_deg)
         rows.append(_row(target.source, cell.controller, cell.trajectory, cell.payload_g, cell.orientation,
                          "as-built", target.rmse_deg, s.mean, s.std, abs(s.mean / target.rmse_deg - 1) <= RMSE_TOLERANCE))
@@ -102,12 +106,13 @@ def valve_rows() -> list[dict]:
     """The §4.4.3 replica's R(d) against eq. 4.4.2 (Pa s/m^3), and the full pulse's delays (ms)."""
     from twin.experiments.studies import valve
     from twin.physics import solenoid
+    from twin.physics.params import NOMINAL_PARAMS
 
     rows = []
-    for r in valve.valve_study().rows:
-        measured, twin = r["resistance_eq442_pa_s_per_m3"], r["resistance_twin_pa_s_per_m3"]
-        checked = r["duty_pct"] >= valve.CHECKED_FROM
-        rows.append(_row(f"4.4.3 valve test, R at {r['duty_pct']:g} % duty (Pa s/m^3)"
+    for duty in valve.DUTIES:
+        measured, twin = float(NOMINAL_PARAMS.valves.resistance(duty)), valve.replica(duty)[0]
+        checked = duty >= valve.CHECKED_FROM
+        rows.append(_row(f"4.4.3 valve test, R at {duty:g} % duty (Pa s/m^3)"
                          + ("" if checked else "; below the 35 % checked"), None, None, None, None,
                          "solenoid valve", measured, twin if math.isfinite(twin) else None, None,
                          checked and math.isfinite(twin) and abs(twin / measured - 1) <= valve.TOLERANCE))
@@ -135,35 +140,30 @@ def openloop_rows() -> tuple[list[dict], object]:
     return [row], study
 
 
-def prediction(workers: int, progress=None) -> tuple[list[dict], dict]:
-    """The T3 cells on the committed preset and on each ensemble member (see the module docstring)."""
-    from twin.plants.as_built import calibrated_values, ensemble_values
+def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], progress=None
+               ) -> tuple[list[dict], list[calibrate.CellResult], dict]:
+    """The T3 cells on each ensemble member and on the ``committed`` values (the runs of the member
+    with those values, which the ensemble lists first, else their own); see the module docstring."""
+    from twin.plants.as_built import ensemble_values
 
     members = ensemble_values()
-    evaluator = calibrate.Evaluator(seeds=SEEDS, workers=workers, cells=PREDICTION_CELLS)
-    try:
-        committed = evaluator.cells(calibrated_values())
+    per_member = []
+    for values in members:
+        per_member.append(evaluator.cells(values, keys=PREDICTION_CELLS))
         if progress:
             progress()
-        per_member = []
-        for values in members:
-            per_member.append(evaluator.cells(values))
-            if progress:
-                progress()
-    finally:
-        evaluator.close()
+    own = next((cells for values, cells in zip(members, per_member, strict=True) if values == committed), None)
+    own = own or evaluator.cells(committed, keys=PREDICTION_CELLS)
     rows = []
     for k, key in enumerate(PREDICTION_CELLS):
         means = [m[k].mean_rmse for m in per_member]
-        stalled = sum(e > STALL_ERROR_DEG for m in per_member for e in m[k].max_error_deg)
         p10, p50, p90 = (float(np.percentile(means, q)) for q in (10, 50, 90))
         rows.append({"controller": key[0], "trajectory": key[1], "payload_g": key[2], "orientation": key[3],
-                     "twin_mean": committed[k].mean_rmse, "band_p10": p10, "band_p50": p50, "band_p90": p90,
-                     "stalled_runs": stalled})
+                     "twin_mean": own[k].mean_rmse, "band_p10": p10, "band_p50": p50, "band_p90": p90,
+                     "stalled_runs": sum(stalled_runs(m[k]) for m in per_member)})
     detail = {"members": members, "runs": len(members) * len(SEEDS),
-              "committed_stalled": [sum(e > STALL_ERROR_DEG for e in c.max_error_deg) for c in committed],
               "per_member": [[c.mean_rmse for c in m] for m in per_member]}
-    return rows, detail
+    return rows, own, detail
 
 
 @dataclasses.dataclass
@@ -171,33 +171,35 @@ class Validation:
     rows: list[dict]
     prediction: list[dict]
     prediction_detail: dict
-    openloop: object
-    failed: int
+    failed: int  # runs with MuJoCo warnings
     stalled: dict  # (controller, trajectory, payload g, orientation) -> stalled runs of the committed preset
 
 
 def validate(*, workers: int = 2, progress=None) -> Validation:
+    """Every comparison, then the prediction; ``progress()`` after the simulations, the fitted cells, the
+    valve, the open loop and each ensemble member."""
+    from twin.plants.as_built import calibrated_values
+
     step = progress or (lambda: None)
-    rows = simulation_rows(workers)
+    rows = simulation_rows()
     step()
+    committed = calibrated_values()
     evaluator = calibrate.Evaluator(seeds=SEEDS, workers=workers)
     try:
-        from twin.plants.as_built import calibrated_values
-        cells = evaluator.cells(calibrated_values())
+        cells = evaluator.cells(committed)
+        rows += measured_rows(cells)
+        step()
+        rows += valve_rows()
+        step()
+        lag_rows, study = openloop_rows()
+        rows += lag_rows
+        step()
+        predicted, own, detail = prediction(evaluator, committed, progress=step)
     finally:
         evaluator.close()
-    rows += measured_rows(cells)
-    step()
-    rows += valve_rows()
-    step()
-    lag_rows, study = openloop_rows()
-    rows += lag_rows
-    step()
-    predicted, detail = prediction(workers, progress=step)
-    failed = sum(c.failed for c in cells) + sum(len(run.warnings) > 0 for run in study.runs)
-    stalled = {c.key: sum(e > STALL_ERROR_DEG for e in c.max_error_deg) for c in cells}
-    return Validation(rows=rows, prediction=predicted, prediction_detail=detail, openloop=study, failed=failed,
-                      stalled=stalled)
+    failed = sum(c.failed for c in (*cells, *own)) + sum(len(run.warnings) > 0 for run in study.runs)
+    return Validation(rows=rows, prediction=predicted, prediction_detail=detail, failed=failed,
+                      stalled={c.key: stalled_runs(c) for c in cells})
 
 
 def _fmt(value, spec=".2f") -> str:
@@ -209,7 +211,7 @@ def _order(rows: Sequence[dict], value: str) -> dict[int, str]:
     out: dict[int, str] = {}
     for t in sorted({r["trajectory"] for r in rows}):
         ranked = sorted((r for r in rows if r["trajectory"] == t), key=lambda r: r[value])
-        out[t] = " < ".join(LABELS[r["controller"]] for r in ranked)
+        out[t] = " < ".join(CONTROLLER_LABELS[r["controller"]] for r in ranked)
     return out
 
 
@@ -229,7 +231,7 @@ def _why(v: Validation) -> list[str]:
         heavy = by.get(("chapter 6 T1", c, 1, 13.5, "vertical"))
         stalled = v.stalled.get((c, 1, 13.5, "vertical"), 0)
         if heavy:
-            lines.append(f"- **{LABELS[c]}, 13.5 g vertical, T1**: measured {heavy['measured']:.2f}, twin "
+            lines.append(f"- **{CONTROLLER_LABELS[c]}, 13.5 g vertical, T1**: measured {heavy['measured']:.2f}, twin "
                          f"{heavy['twin_mean']:.2f} deg, {stalled} of {len(SEEDS)} twin runs stalled. " + (
                              "The twin lifts the payload but tracks it better than the real joint did: the real "
                              "joint lost more to the payload than the twin does (its lift was nearer its edge)."
@@ -253,7 +255,7 @@ def _why(v: Validation) -> list[str]:
     relative = (widest["band_p90"] - widest["band_p10"]) / widest["band_p50"]
     lines.append(f"- **The breakaway**: the ensemble spans {low:.2f}-{high:.2f} N of breakaway, fitting the "
                  f"measurements about equally well; the widest T3 band is {spread_t3:.2f} deg ("
-                 f"{LABELS[widest['controller']]} {widest['payload_g']:g} g {widest['orientation']}: "
+                 f"{CONTROLLER_LABELS[widest['controller']]} {widest['payload_g']:g} g {widest['orientation']}: "
                  f"{relative:.0%} of its median), so within what the data allow the T3 prediction "
                  + ("does not turn on it" if relative < RMSE_TOLERANCE else "**turns on it**: read the band, not "
                     "the committed value")
@@ -264,7 +266,7 @@ def _why(v: Validation) -> list[str]:
     if known:
         lines.append("- **What the band does not hold**: it is the spread over parameter sets that fit equally well, "
                      "not the model's own error. The one T3 cell that was measured and fitted (0 g, horizontal, "
-                     "Chapter 5) is off by " + ", ".join(f"{LABELS[c]} x{r['ratio']:.2f}" for c, r in known.items())
+                     "Chapter 5) is off by " + ", ".join(f"{CONTROLLER_LABELS[c]} x{r['ratio']:.2f}" for c, r in known.items())
                      + "; a T3 prediction is as far off as that, at least, before its band.")
     return lines
 
@@ -297,7 +299,7 @@ def report(v: Validation) -> str:
                       "| controller | T | payload | orientation | measured | twin (mean ± std) | twin / measured | within |",
                       "|---|---|---|---|---|---|---|---|"])
         for r in members:
-            lines.append(f"| {LABELS.get(r['controller'], r['controller'] or '')} | {r['trajectory'] or ''} | "
+            lines.append(f"| {CONTROLLER_LABELS.get(r['controller'], r['controller'] or '')} | {r['trajectory'] or ''} | "
                          f"{'' if r['payload_g'] is None else format(r['payload_g'], 'g') + ' g'} | "
                          f"{r['orientation'] or ''} | {_fmt(r['measured'])} | {_fmt(r['twin_mean'])}"
                          f"{'' if r['twin_std'] is None else ' ± ' + _fmt(r['twin_std'])} | {_fmt(r['ratio'])} | "
@@ -339,7 +341,7 @@ def report(v: Validation) -> str:
               + ", ".join(f"{m['stiction']:.2f}" for m in d["members"]) + ".", "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | stalled |", "|---|---|---|---|---|---|---|---|"]
     for r in v.prediction:
-        lines.append(f"| {LABELS[r['controller']]} | {r['payload_g']:g} g | {r['orientation']} | "
+        lines.append(f"| {CONTROLLER_LABELS[r['controller']]} | {r['payload_g']:g} g | {r['orientation']} | "
                      f"{_fmt(r['twin_mean'])} | {_fmt(r['band_p10'])} | {_fmt(r['band_p50'])} | {_fmt(r['band_p90'])} | "
                      f"{r['stalled_runs']} |")
     lines += ["", "![prediction](prediction.png)", ""]
@@ -385,7 +387,7 @@ def figure_prediction(v: Validation, path: pathlib.Path) -> None:
                 ax.plot(g, member[idx], ".", color=colour, alpha=0.5)
         ax.set_xlabel("payload at the link tip (g)")
         ax.grid(alpha=0.3)
-        ax.set_title(f"{LABELS[controller]}, T3 (blind)")
+        ax.set_title(f"{CONTROLLER_LABELS[controller]}, T3 (blind)")
         ax.legend(fontsize=7)
     axes[0].set_ylabel("RMSE (deg), mean of five runs")
     fig.savefig(path, dpi=110)
@@ -414,32 +416,29 @@ class ValidateExperiment(Experiment):
 
         from twin.plants.as_built import ensemble_values
 
-        total = 4 + 1 + len(ensemble_values())
+        total = 4 + len(ensemble_values())
         with tqdm(total=total, desc="validate", unit="stage", file=sys.stderr) as bar:
             v = validate(workers=args.workers, progress=lambda: bar.update(1))
         within = sum(r["within_tolerance"] for r in v.rows)
         stalled = sum(r["stalled_runs"] for r in v.prediction)
         answer = (f"{within} of {len(v.rows)} comparisons within tolerance (see validation.md). T3 prediction over "
                   f"{len(v.prediction_detail['members'])} ensemble members: "
-                  + "; ".join(f"{LABELS[r['controller']]} {r['payload_g']:g} g {r['orientation'][0].upper()} "
+                  + "; ".join(f"{CONTROLLER_LABELS[r['controller']]} {r['payload_g']:g} g {r['orientation'][0].upper()} "
                               f"{r['twin_mean']:.2f} [{r['band_p10']:.2f}-{r['band_p90']:.2f}]" for r in v.prediction)
                   + f"; {stalled} stalled runs.")
         return Outcome(rows=v.rows, answer=answer, failed=v.failed, detail=v)
 
     def outputs(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
-        """``validation.csv``, ``prediction.csv``, ``validation.md`` and its two figures, each written to a
-        temporary name and renamed."""
+        """``validation.csv``, ``prediction.csv``, ``validation.md`` and its two figures (the CLI's
+        :meth:`publish` makes them all or nothing)."""
         v = outcome.detail
         paths = [out / "validation.csv", out / "prediction.csv", out / "validation.md", out / "validation.png",
                  out / "prediction.png"]
         write_csv(v.rows, VALIDATION_COLUMNS, paths[0])
         write_csv(v.prediction, PREDICTION_COLUMNS, paths[1])
-        for path, make in ((paths[2], lambda tmp: tmp.write_text(report(v))),
-                           (paths[3], lambda tmp: figure_validation(v.rows, tmp)),
-                           (paths[4], lambda tmp: figure_prediction(v, tmp))):
-            tmp = path.with_name(path.stem + ".tmp" + path.suffix)
-            make(tmp)
-            tmp.replace(path)
+        paths[2].write_text(report(v))
+        figure_validation(v.rows, paths[3])
+        figure_prediction(v, paths[4])
         return paths
 
 

@@ -272,7 +272,7 @@ class RobustnessStudyExperiment(Experiment):
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         from tqdm import tqdm
 
-        args.ensemble = getattr(args, "ensemble", True) and args.plant == "as-built"
+        args.ensemble = args.ensemble and args.plant == "as-built"
         points = robustness_grid(plant_name=args.plant, seeds=args.seeds, ensemble=args.ensemble)
         print(f"{len(points)} runs on the {args.plant} plant -> {out.resolve()}", file=sys.stderr)
         with tqdm(total=len(points), unit="run", file=sys.stderr, dynamic_ncols=True, desc="robustness") as bar:

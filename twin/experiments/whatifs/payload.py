@@ -67,9 +67,9 @@ class PayloadWhatIf(Experiment):
             return payload_study(out=store, payloads_g=args.payload_values, trajectory=args.trajectory,
                                  seeds=args.seeds, plant_name=args.plant, workers=args.workers, bar=bar)
 
-    def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
-        """``payload.csv`` and ``payload.txt``, and the sweep store the runs are kept in (resumable)."""
-        return super().write(outcome, out) + [out / "payload-runs"]
+    def kept(self, out: pathlib.Path) -> list[pathlib.Path]:
+        """The sweep store the runs are kept in (resumable)."""
+        return [out / "payload-runs"]
 
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         plot_summary(outcome.rows, path)
