@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from twin.exceptions import InvalidScenario
-from twin.physics.model import MODEL_PATH, Orientation, compile_joint
+from twin.physics.model import MODEL_PATH, Orientation, compile_joint, referred_mass
 from twin.physics.params import JointParams
 
 OBJECTS = [mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_GEOM, mujoco.mjtObj.mjOBJ_SITE,
@@ -83,3 +83,13 @@ def test_solref_is_twice_the_timestep():
 def test_bad_payload_is_rejected(payload):
     with pytest.raises(InvalidScenario):
         compile_joint(payload_mass=payload)
+
+
+def test_referred_mass_closed_form_is_the_multibody_inertia_along_the_rack():
+    """SPEC §2: two rack sides (32.08 g), pinion and spur through their pitch radii, and the link's
+    J / r_s^2 = 10.8 g: the compiled model's dq/dy' M dq/dy without payload, to round-off."""
+    params = JointParams()
+    expected = 2 * (0.46e-3 + 2e-3 + 27.16e-3 / 2) + 4.8e-10 / (3.71e-3 / 2) ** 2 \
+        + (1.095e-8 + 2.45e-7) / (9.525e-3 / 2) ** 2
+    assert referred_mass(params) == pytest.approx(expected, rel=1e-3)
+    assert compile_joint(params=params).effective_mass == pytest.approx(referred_mass(params), rel=1e-9)

@@ -147,7 +147,7 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
     compile_kernels()
     context = multiprocessing.get_context("fork")
     pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context,
-                                                  initializer=_ignore_interrupts)
+                                                  initializer=worker_setup)
     try:
         futures = [pool.submit(run_chunk, chunk) for chunk in chunks]
         for future in concurrent.futures.as_completed(futures):
@@ -164,7 +164,7 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
         pool.shutdown(wait=True)
 
 
-def _ignore_interrupts() -> None:
+def worker_setup() -> None:
     """In a worker: Ctrl-C is the parent's to handle (it stops the workers itself). A worker also dies
     with its parent (Linux's parent-death signal): a worker outliving a SIGKILLed sweep would hold the
     inherited lock on the output folder, and the resume would be refused."""

@@ -152,6 +152,15 @@ def compile_joint(*, params: JointParams = NOMINAL_PARAMS, payload_mass: float =
     )
 
 
+def referred_mass(params: JointParams = NOMINAL_PARAMS) -> float:
+    """The train's inertia referred to the rack without payload, in closed form (kg): both rack sides,
+    the pinion and spur and the link through their pitch radii (SPEC §2's note: 43.5 g, where the
+    thesis's lumped M is 32.9 g). The compiled model's ``effective_mass`` gives the same number."""
+    m, g = params.masses, params.gears
+    return (2.0 * m.rack_side_mass + m.pinion_inertia / g.pinion_radius**2
+            + (m.spur_inertia + m.link_inertia) / g.spur_radius**2)
+
+
 def _joint_space_inertia(model: mujoco.MjModel) -> np.ndarray:
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)

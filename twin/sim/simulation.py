@@ -52,6 +52,9 @@ class Trace:
     tooth_force_spur: np.ndarray  # N, pinion-spur mesh: spur coupling torque / r_s
     tooth_force_rack_a: np.ndarray  # N, rack A - pinion mesh: what rack A pushes into the teeth
     tooth_force_rack_b: np.ndarray  # N, rack B - pinion mesh
+    velocity: np.ndarray  # m/s, true rack velocity (read when the tick was sensed)
+    estimated_velocity: np.ndarray  # m/s, the observer's v_hat at that tick
+    estimated_acceleration: np.ndarray  # m/s^2, the observer's a_hat
 
 
 @dataclasses.dataclass(frozen=True)
@@ -74,13 +77,16 @@ def _warnings(counts: np.ndarray) -> tuple[str, ...]:
 
 
 def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller],
-             progress: Callable[[int, int], None] | None = None, nthread: int = 0) -> list[Result]:
+             progress: Callable[[int, int], None] | None = None, nthread: int = 0,
+             start_positions: np.ndarray | None = None) -> list[Result]:
     """Run every scenario to the end of its trajectory; one :class:`Result` each, in order.
 
     ``controllers[i]`` drives scenario i; scenarios that share one controller
     instance are driven by it together, vectorised (its arrays are in the order
     of those scenarios). ``twin.envs.runner`` builds them from the scenarios' names.
-    ``progress(done_ticks, total_ticks)`` is called as the batch advances.
+    ``progress(done_ticks, total_ticks)`` is called as the batch advances. ``start_positions`` (n,),
+    m: where each rack starts at rest as its sensor reads it, instead of its trajectory's start (an
+    open-loop experiment from chosen rest positions; the reference is still the trajectory's).
     """
     if not scenarios:
         raise InvalidScenario("no scenarios to simulate")
@@ -116,7 +122,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     v_d = np.stack([ref.velocity for ref in references])
     a_d = np.stack([ref.acceleration for ref in references])
 
-    start = true_start(scenarios, y_d[:, 0])  # the Hall sensor reads the reference's start there
+    reported = y_d[:, 0] if start_positions is None else np.asarray(start_positions, dtype=float)
+    start = true_start(scenarios, reported)  # the Hall sensor reads the reference's start there
     for i, joint in enumerate(joints):
         place_on_manifold(qpos[i:i + 1], joint, start[i:i + 1])
     qvel[:] = 0.0
@@ -136,7 +143,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
     active = np.flatnonzero(lengths > 1)  # scenario i is stepped at ticks 0 .. lengths[i] - 2
     ends = {int(length) for length in lengths}
     # Recorded tick-major, (ticks, n): each tick writes contiguous rows.
-    rec = {name: np.zeros((ticks, n)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps", "fs", "fa", "fb")}
+    rec = {name: np.zeros((ticks, n)) for name in ("y", "ym", "theta", "duty", "pa", "pb", "ps", "fs", "fa", "fb", "v", "vh", "ah")}
     valve_open = np.zeros((ticks, n, 4), dtype=bool)
     stage_vel = int(mujoco.mjtStage.mjSTAGE_VEL)
     def step(k: int) -> None:
@@ -164,6 +171,9 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         ticker.tick(command)
         rec["y"][k] = ticker.position
         rec["ym"][k] = ticker.measurement.position  # what tick k sensed
+        rec["v"][k] = ticker.velocity
+        rec["vh"][k] = ticker.measurement.velocity
+        rec["ah"][k] = ticker.measurement.acceleration
         rec["duty"][k] = duty
         rec["pa"][k] = plant.pressure_a
         rec["pb"][k] = plant.pressure_b
@@ -195,6 +205,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
             pressure_a=series["pa"], pressure_b=series["pb"], supply_pressure=series["ps"],
             coupling_error=theta - series["y"] / spur_radius[i],
             tooth_force_spur=series["fs"], tooth_force_rack_a=series["fa"], tooth_force_rack_b=series["fb"],
+            velocity=series["v"], estimated_velocity=series["vh"], estimated_acceleration=series["ah"],
         )
         tr_i = trajectories[i]
         scored = series["ym"] / spur_radius[i] if plants[i].metrics_on_sensor else theta

@@ -1,0 +1,125 @@
+"""What the ensemble what-ifs share (``pva-rate``, ``observer``, ``next-experiment``): the Chapter 6
+cells, runs of many cases on every member of the as-built calibration ensemble, and the band.
+
+Each member of the calibration ensemble (:func:`twin.plants.as_built.ensemble_plants`; member 0 has
+the committed preset's values) runs every case over the same seeds, in one batch per member, the
+members shared out over worker processes. A case's number is its committed-preset value (member
+0's mean over the seeds) and its band the 10 / 90 % percentiles of the members' means: the spread
+that comes from what the measurements could not pin down, not from the sensor noise.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import dataclasses
+import math
+import multiprocessing
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from twin.exceptions import InvalidScenario
+from twin.experiments.reference import THESIS_PAYLOADS_G
+
+# The Chapter 6 cells (§9): controller, trajectory, payload g, orientation; T1 and T3.
+CHAPTER6_CELLS = tuple((c, t, g, o) for c in ("ffpva", "smc") for t in (1, 3) for o in ("horizontal", "vertical")
+                       for g in THESIS_PAYLOADS_G)
+BAND_PERCENTILES = (10.0, 90.0)
+
+
+def study_cells(controllers: Sequence[str] = ("ffpva", "smc")) -> tuple[tuple, ...]:
+    """T1-T4 horizontal without payload (Chapter 5), then the Chapter 6 cells that are not among them."""
+    first = [(c, t, 0.0, "horizontal") for c in controllers for t in (1, 2, 3, 4)]
+    return tuple(first + [cell for cell in CHAPTER6_CELLS if cell[0] in controllers and cell not in first])
+
+
+@dataclasses.dataclass(frozen=True)
+class Run:
+    """What the what-ifs keep of one run (degrees; m/s for the observer's errors)."""
+
+    rmse_deg: float
+    max_error_deg: float
+    failed: bool
+    velocity_rms_error: float  # m/s, observer v_hat against the true rack velocity
+    acceleration_rms_error: float  # m/s^2, a_hat against the true velocity's difference quotient
+
+
+def summarise_run(result) -> Run:
+    trace = result.trace
+    true_acceleration = np.gradient(trace.velocity, trace.time) if len(trace.time) > 1 else np.zeros(1)
+    return Run(rmse_deg=math.degrees(result.metrics.rmse), max_error_deg=math.degrees(result.metrics.max_error),
+               failed=bool(result.warnings),
+               velocity_rms_error=float(np.sqrt(np.mean((trace.estimated_velocity - trace.velocity) ** 2))),
+               acceleration_rms_error=float(np.sqrt(np.mean((trace.estimated_acceleration - true_acceleration) ** 2))))
+
+
+def check_members(members: int | None) -> None:
+    """``--members``: a calibration file must exist, and N at most its ensemble's size."""
+    from twin.plants.as_built import CALIBRATION_FILE
+
+    if not CALIBRATION_FILE.exists():
+        raise InvalidScenario("no as-built calibration: run `twin calibrate` first")
+    count = member_count()
+    if members is not None and members > count:
+        raise InvalidScenario(f"--members: the calibration ensemble has {count} members, got {members}")
+
+
+def add_ensemble_arguments(parser, *, seeds: int) -> None:
+    """``--seeds`` and ``--members``, the flags every ensemble what-if has."""
+    from twin.experiments.arguments import positive_int
+
+    parser.add_argument("--seeds", type=positive_int, default=seeds,
+                        help=f"noise seeds per case and ensemble member (default {seeds})")
+    parser.add_argument("--members", type=positive_int, default=None,
+                        help="only the first N calibration ensemble members (default: all)")
+
+
+def member_count() -> int:
+    from twin.plants.as_built import ensemble_values
+
+    return len(ensemble_values())
+
+
+def _run_member(batch: Callable, member: int, cases: tuple, seeds: tuple) -> tuple[int, dict]:
+    """``batch(plant, cases, seeds)`` on ensemble member ``member``: {(case, seed): Run}."""
+    from twin.plants.as_built import ensemble_plants
+
+    return member, batch(ensemble_plants()[member], cases, seeds)
+
+
+def over_ensemble(batch: Callable, cases: Sequence, *, seeds: Sequence[int], workers: int = 2,
+                  members: int | None = None, progress: Callable[[], None] | None = None) -> list[dict]:
+    """``batch(plant, cases, seeds) -> {(case, seed): Run}`` (a module-level function, so it reaches
+    the workers) on every ensemble member (or the first ``members``), members in parallel on
+    ``workers`` processes; ``progress()`` after each member. One dict per member, in member order."""
+    count = member_count() if members is None else members
+    done: dict[int, dict] = {}
+    if workers <= 1:
+        for m in range(count):
+            done[m] = _run_member(batch, m, tuple(cases), tuple(seeds))[1]
+            if progress:
+                progress()
+    else:
+        from twin.batch.sweep import worker_setup  # workers die with their parent
+
+        with concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
+                                                    initializer=worker_setup) as pool:
+            futures = [pool.submit(_run_member, batch, m, tuple(cases), tuple(seeds)) for m in range(count)]
+            for future in concurrent.futures.as_completed(futures):
+                m, runs = future.result()
+                done[m] = runs
+                if progress:
+                    progress()
+    return [done[m] for m in range(count)]
+
+
+def band(per_member: Sequence[dict], case, seeds: Sequence[int], field: str = "rmse_deg") -> dict:
+    """The committed preset's value (member 0's seed mean) and the 10 / 90 % band of the members'
+    seed means of ``field`` for ``case``."""
+    means = [float(np.mean([getattr(runs[case, s], field) for s in seeds])) for runs in per_member]
+    low, high = (float(np.percentile(means, q)) for q in BAND_PERCENTILES)
+    return {"value": means[0], "p10": low, "p90": high, "members": means}
+
+
+def failed_runs(per_member: Sequence[dict]) -> int:
+    return sum(run.failed for runs in per_member for run in runs.values())
