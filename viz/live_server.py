@@ -23,7 +23,9 @@ import json
 import math
 import os
 import pathlib
+import signal
 import sys
+import threading
 import time
 import urllib.parse
 from collections.abc import Callable
@@ -39,14 +41,17 @@ import umsgpack
 from meshcat.commands import Delete
 from meshcat.path import Path
 
-from twin.envs.live import LiveJoint, Readout
+from twin.envs.live import Compare, LiveJoint, LiveJoints, Readout
 from twin.exceptions import SimulationFailed, TwinError
 from twin.sim.scenario import Scenario
 from viz import live_messages
-from viz.recording import FPS, MESHCAT_SCRIPT, TraceRows, title_of, write_page
-from viz.scene import Frame, JointScene, frame_commands
+from viz.recording import FPS, MESHCAT_SCRIPT, STRIP_CHART_SCRIPT, TraceRows, compare_label, title_of, write_page
+from viz.scene import COMPARE_ROOT, COMPARE_TINT, Frame, JointScene, frame_commands, scene_commands
 
-FRAME_RATE = 30.0  # pictures per second of wall time
+FRAME_RATE = 30.0  # pictures per second of wall time (and plot updates)
+SAMPLE_PERIOD = 5e-3  # s of simulated time between plotted samples (valves: every change)
+REPLAY_ON_CONNECT = 1  # the trajectory replayed when the first page connects, so the joint moves on open
+STOP_GRACE = 0.3  # s for the last messages to leave before the server's loop ends
 MIN_REBUILD_INTERVAL = 0.5  # s between model rebuilds (each compiles the model on the server's thread)
 MAX_LAG_FRAMES = 3.0  # a late picture catches up at most this many frames of simulated time
 # Tornado closes the socket on a larger WebSocket message without reading it; below this, an oversized
@@ -63,57 +68,140 @@ class ServerError(TwinError):
 
 @dataclasses.dataclass
 class _Recorder:
-    """The frames and trace rows of the current model's run, for ``--html``."""
+    """The frames and trace rows of the current model's run, for ``--html``: one row list per joint."""
 
     frames: list[Frame] = dataclasses.field(default_factory=list)
     rows: list[tuple] = dataclasses.field(default_factory=list)
+    compare_rows: list[tuple] = dataclasses.field(default_factory=list)
+    valves: tuple[list, list] = dataclasses.field(default_factory=lambda: ([], []))  # changes, per joint
 
-    def add(self, frame: Frame, row: tuple) -> None:
+    def add(self, frame: Frame, row: tuple, compare_row: tuple | None = None) -> None:
         self.frames.append(frame)
         self.rows.append(row)
+        if compare_row is not None:
+            self.compare_rows.append(compare_row)
         if len(self.frames) > MAX_RECORDED_FRAMES:
             del self.frames[0], self.rows[0]
+            if self.compare_rows:
+                del self.compare_rows[0]
+            for changes in self.valves:
+                while len(changes) > 1 and changes[1][0] <= self.rows[0][0]:
+                    del changes[0]
 
-    def trace_rows(self) -> TraceRows:
-        columns = np.array(self.rows, dtype=float).reshape(-1, 7).T
+    def trace_rows(self, *, compare: bool = False) -> TraceRows:
+        rows = self.compare_rows if compare else self.rows
+        columns = np.array([row[:7] for row in rows], dtype=float).reshape(-1, 7).T
         time_, angle, desired, duty, pa, pb, supply = columns
-        return TraceRows(time=time_ - time_[0] if len(time_) else time_, angle=angle, desired_angle=desired,
-                         duty=duty, pressure_a=pa, pressure_b=pb, supply_pressure=supply)
+        start = time_[0] if len(time_) else 0.0
+        changes = [[max(t - start, 0.0), is_open] for t, is_open in self.valves[1 if compare else 0]]
+        return TraceRows(time=time_ - start, angle=angle, desired_angle=desired, duty=duty, pressure_a=pa,
+                         pressure_b=pb, supply_pressure=supply, valve_changes=changes)
+
+
+def _row(r: Readout) -> tuple:
+    return (r.time, r.angle, r.desired_angle, r.duty, r.pressure_a, r.pressure_b, r.supply_pressure)
+
+
+class _Samples:
+    """One joint's traces since the page's last frame, for its strip charts: every ``SAMPLE_TICKS``
+    ticks a sample (degrees, %, kPa), and the valves' every change (tick exact: a 1 ms pulse shows)."""
+
+    FIELDS = ("time", "angle_deg", "desired_deg", "error_deg", "duty", "pressure_a_kpa", "pressure_b_kpa",
+              "supply_kpa")
+
+    def __init__(self) -> None:
+        self.columns: dict[str, list[float]] = {name: [] for name in self.FIELDS}
+        self.valves: list[list] = []  # [time (s), [V1..V4 open]] at each change
+        self.last_open = b""
+
+    def take(self, joint: LiveJoint) -> None:
+        r = joint.readout()
+        for name, value in zip(self.FIELDS, (r.time, math.degrees(r.angle), math.degrees(r.desired_angle),
+                                             math.degrees(r.error), r.duty, r.pressure_a / 1e3,
+                                             r.pressure_b / 1e3, r.supply_pressure / 1e3), strict=True):
+            self.columns[name].append(round(value, 4))
+
+    def watch_valves(self, joint: LiveJoint) -> list | None:
+        """The change ``[time, [V1..V4]]`` if the valves changed since the last call, else None."""
+        is_open = joint.plant.conductance[0] > 0
+        packed = is_open.tobytes()
+        if packed == self.last_open:
+            return None
+        self.last_open = packed
+        change = [round(joint.time, 4), [bool(x) for x in is_open]]
+        self.valves.append(change)
+        return change
+
+    def drain(self) -> dict:
+        taken = {**self.columns, "valves": self.valves}
+        self.columns = {name: [] for name in self.FIELDS}
+        self.valves = []
+        return taken
 
 
 class LiveSession:
-    """What one ``twin view`` shows: a :class:`LiveJoint`, its scene, and the page's commands."""
+    """What one ``twin view`` shows: :class:`LiveJoints` (one joint, or two in compare mode), their
+    scene, the samples for the page's plots, and the page's commands."""
 
-    def __init__(self, scenario: Scenario, *, record: bool = False):
+    def __init__(self, scenario: Scenario, *, record: bool = False, compare: Compare | None = None):
         self.record = record
+        self.compare = compare
         self._rebuilt_at = -math.inf
         self._start(scenario)
 
     def _start(self, scenario: Scenario) -> None:
-        self.joint = LiveJoint(scenario)
-        self.scene = JointScene(self.joint.joint, supply_pressure=scenario.supply)
+        self.joints = LiveJoints(scenario, self.compare)
+        self.scenes = [JointScene(joint.joint, supply_pressure=joint.scenario.supply, root=root, tint=tint)
+                       for joint, root, tint in zip(self.joints.joints, ("twin", COMPARE_ROOT), (None, COMPARE_TINT),
+                                                    strict=False)]
+        self.samples = [_Samples() for _ in self.joints.joints]
         self.recorder = _Recorder()
         self._debt = 0.0  # s of simulated time asked for but not yet a whole tick
         self.record_every = max(1, round(1.0 / (FPS * self.joint.tick)))
+        self.sample_every = max(1, round(SAMPLE_PERIOD / self.joint.tick))
+        self._sample()
         self._capture()
+
+    @property
+    def joint(self) -> LiveJoint:
+        """The first joint."""
+        return self.joints.first
+
+    @property
+    def scene(self) -> JointScene:
+        return self.scenes[0]
 
     @property
     def scenario(self) -> Scenario:
         return self.joint.scenario
 
     def setup_commands(self) -> list[dict]:
-        return [Delete(Path(("twin",))).lower(), *self.scene.setup_commands()]
+        return [Delete(Path(("twin",))).lower(), Delete(Path((COMPARE_ROOT,))).lower(),
+                *scene_commands(self.scenes)]
 
-    def frame(self, r: Readout | None = None) -> Frame:
-        r = self.joint.readout() if r is None else r
-        return self.scene.frame(self.joint.data, desired_angle=r.desired_angle,
-                                pressures=(r.pressure_a, r.pressure_b), valve_open=r.valve_open)
+    def frame(self) -> Frame:
+        """Every joint's picture as one frame."""
+        transforms, colours = {}, {}
+        for joint, scene in zip(self.joints.joints, self.scenes, strict=True):
+            r = joint.readout()
+            one = scene.frame(joint.data, desired_angle=r.desired_angle, pressures=(r.pressure_a, r.pressure_b),
+                              valve_open=r.valve_open)
+            transforms.update(one.transforms)
+            colours.update(one.colours)
+        return Frame(transforms=transforms, colours=colours)
 
     def _capture(self) -> None:
         if self.record:
-            r = self.joint.readout()
-            self.recorder.add(self.frame(r), (r.time, r.angle, r.desired_angle, r.duty, r.pressure_a,
-                                             r.pressure_b, r.supply_pressure))
+            second = self.joints.second
+            self.recorder.add(self.frame(), _row(self.joint.readout()),
+                              None if second is None else _row(second.readout()))
+
+    def _sample(self) -> None:
+        for i, (joint, samples) in enumerate(zip(self.joints.joints, self.samples, strict=True)):
+            change = samples.watch_valves(joint)
+            if change is not None and self.record:
+                self.recorder.valves[i].append(change)
+            samples.take(joint)
 
     def advance(self, duration: float) -> None:
         """Step ``duration`` seconds; the fraction of a tick left over is carried to the next call.
@@ -121,25 +209,36 @@ class LiveSession:
         self._debt += duration
         ticks = int(self._debt / self.joint.tick + 1e-9)
         self._debt -= ticks * self.joint.tick
+        pairs = list(zip(self.joints.joints, self.samples, strict=True))
         for _ in range(ticks):
-            self.joint.step()
-            if self.joint.steps % self.record_every == 0:
+            self.joints.step()
+            steps = self.joint.steps
+            for i, (joint, samples) in enumerate(pairs):
+                change = samples.watch_valves(joint)
+                if change is not None and self.record:
+                    self.recorder.valves[i].append(change)
+            if steps % self.sample_every == 0:
+                for joint, samples in pairs:
+                    samples.take(joint)
+            if steps % self.record_every == 0:
                 self._capture()
-        data = self.joint.data
-        warned = [mujoco.mjtWarning(i).name for i, w in enumerate(data.warning) if w.number > 0]
-        if warned or not np.all(np.isfinite(data.qpos)):
-            raise SimulationFailed(f"MuJoCo {', '.join(warned) or 'state not finite'} at "
-                                   f"t = {self.joint.time:.3f} s")
+        for joint in self.joints.joints:
+            data = joint.data
+            warned = [mujoco.mjtWarning(i).name for i, w in enumerate(data.warning) if w.number > 0]
+            if warned or not np.all(np.isfinite(data.qpos)):
+                which = "" if joint is self.joint else " (compare joint)"
+                raise SimulationFailed(f"MuJoCo {', '.join(warned) or 'state not finite'} at "
+                                       f"t = {joint.time:.3f} s{which}")
 
     def handle(self, text: str | bytes) -> bool:
         """Apply one message from the page; True if the model was rebuilt. Raises BadMessage."""
         command = live_messages.parse(text)
         if isinstance(command, live_messages.Target):
-            self.joint.set_target(command.angle)
+            self.joints.set_target(command.angle)
         elif isinstance(command, live_messages.PlayTrajectory):
-            self.joint.play(command.number)
+            self.joints.play(command.number)
         elif isinstance(command, live_messages.SwitchController):
-            self.joint.switch_controller(command.name)
+            self.joints.switch_controller(command.name)
         else:
             now = time.monotonic()
             if now - self._rebuilt_at < MIN_REBUILD_INTERVAL:
@@ -151,25 +250,54 @@ class LiveSession:
             return True
         return False
 
+    def play(self, number: int) -> None:
+        """Replay trajectory ``number`` on every joint (as the page's T buttons do)."""
+        self.joints.play(number)
+
     def readout(self) -> dict:
+        """The first joint's readout now (and the second's angle), with every joint's samples since
+        the last call."""
         r = self.joint.readout()
-        return {"type": "readout", "time": r.time, "angle_deg": math.degrees(r.angle),
-                "desired_deg": math.degrees(r.desired_angle), "error_deg": math.degrees(r.error),
-                "duty": r.duty, "pressure_a_kpa": r.pressure_a / 1e3, "pressure_b_kpa": r.pressure_b / 1e3,
-                "supply_kpa": r.supply_pressure / 1e3, "valves": list(r.valve_open)}
+        message = {"type": "readout", "time": r.time, "angle_deg": math.degrees(r.angle),
+                   "desired_deg": math.degrees(r.desired_angle), "error_deg": math.degrees(r.error),
+                   "duty": r.duty, "pressure_a_kpa": r.pressure_a / 1e3, "pressure_b_kpa": r.pressure_b / 1e3,
+                   "supply_kpa": r.supply_pressure / 1e3, "valves": list(r.valve_open),
+                   "samples": [samples.drain() for samples in self.samples]}
+        second = self.joints.second
+        if second is not None:
+            c = second.readout()
+            message.update(compare_angle_deg=math.degrees(c.angle), compare_error_deg=math.degrees(c.error),
+                           compare_duty=c.duty)
+        return message
 
     def state(self) -> dict:
         s, plan = self.scenario, self.joint.plan
-        target = math.degrees(plan.start + sum(seg.delta for seg in plan.segments))
+        target = math.degrees(self.joints.target())
         playing = f"T{plan.number}" if plan.number else f"target {target:.0f} deg"
-        return {"type": "state", "controller": s.controller, "trajectory": s.trajectory, "playing": playing,
-                "payload_g": s.payload * 1e3, "orientation": s.orientation.value, "plant": s.plant_name}
+        state = {"type": "state", "controller": s.controller, "trajectory": s.trajectory, "playing": playing,
+                 "target_deg": round(target, 6), "payload_g": s.payload * 1e3, "orientation": s.orientation.value,
+                 "plant": s.plant_name, "supply_kpa": s.supply / 1e3, "compare": None}
+        second = self.joints.second
+        if second is not None:
+            c = second.scenario
+            state["compare"] = {"settings": dict(self.compare.text), "controller": c.controller,
+                                "payload_g": c.payload * 1e3, "orientation": c.orientation.value,
+                                "plant": c.plant_name, "supply_kpa": c.supply / 1e3}
+        return state
 
     def write_html(self, path: pathlib.Path) -> None:
         """The current model's run as a recording, written whole (a temporary file, then renamed)."""
         tmp = path.with_name(path.name + ".tmp")
-        write_page(tmp, scene=self.scene, frames=self.recorder.frames, rows=self.recorder.trace_rows(),
-                   title=f"live: {title_of(self.scenario)}")
+        rows = [self.recorder.trace_rows()]
+        if self.joints.second is not None:
+            rows.append(self.recorder.trace_rows(compare=True))
+        title = f"live: {title_of(self.scenario)}"
+        if self.compare is not None:
+            title += f" vs {compare_label(self.compare.text)}"
+        labels = [f"{self.scenario.controller}, {self.scenario.plant_name}"]
+        if self.compare is not None:
+            labels.append(f"compare: {compare_label(self.compare.text)}")
+        write_page(tmp, scenes=self.scenes, frames=self.recorder.frames, rows=rows, title=title, labels=labels)
         os.replace(tmp, path)
 
 
@@ -207,9 +335,12 @@ class _PageHandler(tornado.web.RequestHandler):
 
 
 class _ScriptHandler(tornado.web.RequestHandler):
+    def initialize(self, script) -> None:
+        self.script = script
+
     def get(self) -> None:
         self.set_header("Content-Type", "application/javascript")
-        self.write(MESHCAT_SCRIPT.read_bytes())
+        self.write(self.script.read_bytes())
 
 
 class _SocketHandler(tornado.websocket.WebSocketHandler):
@@ -224,6 +355,10 @@ class _SocketHandler(tornado.websocket.WebSocketHandler):
 
     def open(self) -> None:
         self.viewer.clients.add(self)
+        if not self.viewer.greeted:  # the first page sees the joint move: replay T1 for it
+            self.viewer.greeted = True
+            self.viewer.session.play(REPLAY_ON_CONNECT)
+            self.viewer.broadcast([json.dumps(self.viewer.session.state())])
         for message in [*_packed(self.viewer.session.setup_commands()), json.dumps(self.viewer.session.state())]:
             _send(self, message)
 
@@ -242,10 +377,12 @@ class LiveViewer:
         self.session, self.speed, self.on_frame = session, speed, on_frame
         self.clients: set[_SocketHandler] = set()
         app = tornado.web.Application([
-            (r"/", _PageHandler, {"viewer": self}), (r"/meshcat.js", _ScriptHandler),
+            (r"/", _PageHandler, {"viewer": self}), (r"/meshcat.js", _ScriptHandler, {"script": MESHCAT_SCRIPT}),
+            (r"/strip_chart.js", _ScriptHandler, {"script": STRIP_CHART_SCRIPT}),
             (r"/ws", _SocketHandler, {"viewer": self}),
         ], log_function=lambda handler: None, websocket_max_message_size=MAX_MESSAGE_BYTES)
         self.failure: str | None = None
+        self.greeted = False  # a page has connected
         try:
             self.sockets = tornado.netutil.bind_sockets(port, address=host)
         except OSError as error:
@@ -299,19 +436,36 @@ class LiveViewer:
             print(f"twin view: {self.failure}", file=sys.stderr, flush=True)
             self.broadcast([json.dumps({"type": "error", "message": self.failure})])
             return
+        readout = json.dumps(self.session.readout())  # drains the samples, shown or not
         if self.clients:
-            self.broadcast([*_packed(frame_commands(self.session.frame())), json.dumps(self.session.readout())],
-                           droppable=True)
+            self.broadcast([*_packed(frame_commands(self.session.frame())), readout], droppable=True)
         if self.on_frame is not None:
             self.on_frame()
 
     def start(self) -> None:
+        """Serve until :meth:`stop`, :meth:`shutdown`, or (on the main thread) SIGINT/SIGTERM, which
+        shut down: the pages are told that the twin stopped before their sockets close."""
         self.server.add_sockets(self.sockets)
         self._last = time.perf_counter()
         self.loop = tornado.ioloop.IOLoop.current()
         self.clock = tornado.ioloop.PeriodicCallback(self._tick, 1000.0 / FRAME_RATE)
         self.clock.start()
-        self.loop.start()
+        previous = {}
+        if threading.current_thread() is threading.main_thread():
+            for number in (signal.SIGINT, signal.SIGTERM):
+                previous[number] = signal.signal(
+                    number, lambda *_: self.loop.asyncio_loop.call_soon_threadsafe(self.shutdown))
+        try:
+            self.loop.start()
+        finally:
+            for number, handler in previous.items():
+                signal.signal(number, handler)
+
+    def shutdown(self) -> None:
+        """Tell every page that the twin stopped (not a lost connection), then stop."""
+        self.clock.stop()
+        self.broadcast([json.dumps({"type": "stopped", "message": "the twin stopped"})])
+        self.loop.call_later(STOP_GRACE, self.stop)
 
     def stop(self) -> None:
         self.clock.stop()

@@ -1,7 +1,10 @@
-"""A run as one self-contained HTML file: the 3D animation with meshcat's
-play/pause/scrub controls beside a plot of the run's key traces, with a cursor
-that follows the animation's clock. Works offline: meshcat's viewer script,
-the scene, the animation and the plot are all inside the file.
+"""A run as one self-contained HTML file: the 3D animation beside strip charts
+of the run's traces (angle and desired, error, duty, pressures, valves), with
+the page's own play / pause / scrub / speed controls driving one clock that
+poses the 3D view and moves the charts' cursor together. In compare mode both
+joints are drawn and their traces overlaid. Works offline: meshcat's viewer
+script, the chart drawer (``viz/strip_chart.js``), the scene, the animation and
+the traces are all inside the file.
 """
 
 from __future__ import annotations
@@ -10,7 +13,6 @@ import base64
 import dataclasses
 import html
 import importlib.resources
-import io
 import json
 import pathlib
 from collections.abc import Sequence
@@ -21,16 +23,18 @@ from meshcat.transformations import quaternion_from_matrix
 
 from twin.physics.model import compile_joint
 from twin.sim.simulation import Result
-from viz.scene import Frame, JointScene
+from viz.scene import COMPARE_ROOT, COMPARE_TINT, Frame, JointScene, scene_commands
 
 FPS = 50  # animation frames per second of simulated time
 PAGE = importlib.resources.files("viz") / "recording_page.html"  # package data
 MESHCAT_SCRIPT = importlib.resources.files("meshcat") / "viewer" / "dist" / "main.min.js"
+STRIP_CHART_SCRIPT = importlib.resources.files("viz") / "strip_chart.js"  # package data
 
 
 @dataclasses.dataclass(frozen=True)
 class TraceRows:
-    """The traces a recording plots, one row per animation frame; SI units."""
+    """The traces a recording plots, one row per animation frame; SI units. The valves are kept
+    as their changes, tick exact, since a PWM pulse is shorter than a frame."""
 
     time: np.ndarray  # s
     angle: np.ndarray  # rad
@@ -39,13 +43,25 @@ class TraceRows:
     pressure_a: np.ndarray  # Pa
     pressure_b: np.ndarray  # Pa
     supply_pressure: np.ndarray  # Pa
+    valve_changes: list  # [time (s), [V1..V4 open]] at the start and at each change
 
     def as_json(self) -> dict:
-        """Degrees and kPa for the page's readout."""
+        """Degrees and kPa, the field names of the live page's samples."""
         return {"time": self.time.tolist(), "angle_deg": np.degrees(self.angle).tolist(),
-                "desired_deg": np.degrees(self.desired_angle).tolist(), "duty": self.duty.tolist(),
+                "desired_deg": np.degrees(self.desired_angle).tolist(),
+                "error_deg": np.degrees(self.desired_angle - self.angle).tolist(), "duty": self.duty.tolist(),
                 "pressure_a_kpa": (self.pressure_a / 1e3).tolist(),
-                "pressure_b_kpa": (self.pressure_b / 1e3).tolist()}
+                "pressure_b_kpa": (self.pressure_b / 1e3).tolist(),
+                "supply_kpa": (self.supply_pressure / 1e3).tolist(),
+                "valves": [[float(t), [bool(v) for v in is_open]] for t, is_open in self.valve_changes]}
+
+
+def valve_changes(time: np.ndarray, valve_open: np.ndarray) -> list:
+    """``[time, [V1..V4]]`` at the first row and wherever ``valve_open`` (n, 4) changes."""
+    if len(time) == 0:
+        return []
+    changed = np.flatnonzero(np.any(valve_open[1:] != valve_open[:-1], axis=1)) + 1
+    return [[float(time[k]), [bool(v) for v in valve_open[k]]] for k in (0, *changed)]
 
 
 def animation_command(frames: Sequence[Frame], fps: int) -> dict:
@@ -87,56 +103,35 @@ def replay_frames(scene: JointScene, result: Result, fps: int) -> tuple[list[Fra
         for k in rows]
     return frames, TraceRows(time=tr.time[rows], angle=tr.angle[rows], desired_angle=tr.desired_angle[rows],
                              duty=tr.duty[rows], pressure_a=tr.pressure_a[rows], pressure_b=tr.pressure_b[rows],
-                             supply_pressure=tr.supply_pressure[rows])
+                             supply_pressure=tr.supply_pressure[rows],
+                             valve_changes=valve_changes(tr.time, np.asarray(tr.valve_open, dtype=bool)))
 
 
-def plot_png(rows: TraceRows, title: str) -> tuple[bytes, dict]:
-    """The key traces as a PNG, and where its time axis lies across the image (fractions of its width)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    fig, axes = plt.subplots(3, 1, sharex=True, figsize=(6.0, 6.4), dpi=100)
-    axes[0].plot(rows.time, np.degrees(rows.desired_angle), "k--", lw=1, label="desired")
-    axes[0].plot(rows.time, np.degrees(rows.angle), color="tab:red", lw=1, label="actual")
-    axes[0].set_ylabel("angle (deg)")
-    axes[0].legend(loc="best", fontsize=8)
-    axes[1].step(rows.time, rows.duty, where="post", color="tab:blue", lw=0.8)
-    axes[1].set_ylabel("duty (%)")
-    axes[2].plot(rows.time, rows.pressure_a / 1e3, lw=0.8, label="chamber A")
-    axes[2].plot(rows.time, rows.pressure_b / 1e3, lw=0.8, label="chamber B")
-    axes[2].plot(rows.time, rows.supply_pressure / 1e3, "k:", lw=0.8, label="supply")
-    axes[2].set_ylabel("pressure (kPa)")
-    axes[2].set_xlabel("time (s)")
-    axes[2].legend(loc="best", fontsize=8)
-    fig.suptitle(title, fontsize=10)
-    fig.tight_layout()
-    box = axes[0].get_position()
-    t0, t1 = axes[0].get_xlim()
-    buffer = io.BytesIO()
-    fig.savefig(buffer, format="png")
-    plt.close(fig)
-    return buffer.getvalue(), {"left": box.x0, "right": box.x1, "t0": t0, "t1": t1}
+def compare_label(text: dict) -> str:
+    """``controller=smc, payload=13.5``: compare mode's settings as the user wrote them."""
+    return ", ".join(f"{key}={value}" for key, value in text.items())
 
 
-def page(*, title: str, commands: Sequence[dict], rows: TraceRows) -> str:
-    """The HTML text of a recording of ``commands`` (scene + animation) and ``rows``."""
-    png, axis = plot_png(rows, title)
+def page(*, title: str, commands: Sequence[dict], rows: Sequence[TraceRows], labels: Sequence[str]) -> str:
+    """The HTML text of a recording of ``commands`` (scene + animation) and its traces ``rows`` (the
+    first joint's, and the second's in compare mode), named by ``labels`` in the charts' legend."""
     packed = [base64.b64encode(umsgpack.packb(c)).decode("ascii") for c in commands]
+    traces = [r.as_json() for r in rows]
     return (PAGE.read_text()
             .replace("{{title}}", html.escape(title))
             .replace("{{commands}}", json.dumps(packed))
-            .replace("{{plot}}", base64.b64encode(png).decode("ascii"))
-            .replace("{{axis}}", json.dumps(axis))
-            .replace("{{trace}}", json.dumps(rows.as_json()))
+            .replace("{{trace}}", json.dumps(traces[0]))
+            .replace("{{traces}}", json.dumps(traces))
+            .replace("{{labels}}", json.dumps(list(labels)))
+            .replace("{{strip_chart_script}}", STRIP_CHART_SCRIPT.read_text().replace("</script>", "<\\/script>"))
             .replace("{{meshcat_script}}", MESHCAT_SCRIPT.read_text().replace("</script>", "<\\/script>")))
 
 
-def write_page(path: pathlib.Path, *, scene: JointScene, frames: Sequence[Frame], rows: TraceRows,
-               title: str, fps: int = FPS) -> None:
-    path.write_text(page(title=title, commands=[*scene.setup_commands(), animation_command(frames, fps)],
-                         rows=rows))
+def write_page(path: pathlib.Path, *, scenes: Sequence[JointScene], frames: Sequence[Frame],
+               rows: Sequence[TraceRows], title: str, labels: Sequence[str] = ("first", "compare"),
+               fps: int = FPS) -> None:
+    path.write_text(page(title=title, commands=[*scene_commands(scenes), animation_command(frames, fps)],
+                         rows=rows, labels=labels[:len(rows)]))
 
 
 def title_of(scenario) -> str:
@@ -144,13 +139,29 @@ def title_of(scenario) -> str:
             f"{scenario.orientation.value} ({scenario.plant_name}, seed {scenario.seed})")
 
 
-def write_recording(result: Result, path: pathlib.Path, *, fps: int = FPS) -> None:
-    """Write ``result`` as a self-contained HTML recording at ``path``."""
-    s = result.scenario
-    preset = s.preset
-    joint = compile_joint(params=preset.params, payload_mass=s.payload, orientation=s.orientation,
-                          timestep=preset.timestep)
-    scene = JointScene(joint, supply_pressure=s.supply)
-    frames, rows = replay_frames(scene, result, fps)
-    rmse = np.degrees(result.metrics.rmse)
-    write_page(path, scene=scene, frames=frames, rows=rows, title=f"{title_of(s)}: RMSE {rmse:.2f} deg", fps=fps)
+def write_recording(result: Result, path: pathlib.Path, *, compare: Result | None = None,
+                    compare_text: dict | None = None, fps: int = FPS) -> None:
+    """Write ``result`` as a self-contained HTML recording at ``path``; with ``compare`` (a run of
+    the same trajectory, its settings ``compare_text`` as the user wrote them), both joints."""
+    scenes, all_frames, all_rows = [], [], []
+    for run_, root, tint in zip((result, compare), ("twin", COMPARE_ROOT), (None, COMPARE_TINT), strict=True):
+        if run_ is None:
+            continue
+        s = run_.scenario
+        preset = s.preset
+        joint = compile_joint(params=preset.params, payload_mass=s.payload, orientation=s.orientation,
+                              timestep=preset.timestep)
+        scene = JointScene(joint, supply_pressure=s.supply, root=root, tint=tint)
+        frames, rows = replay_frames(scene, run_, fps)
+        scenes.append(scene)
+        all_frames.append(frames)
+        all_rows.append(rows)
+    frames = [Frame(transforms={**a.transforms, **b.transforms}, colours={**a.colours, **b.colours})
+              for a, b in zip(all_frames[0], all_frames[-1], strict=False)] if compare is not None else all_frames[0]
+    title = f"{title_of(result.scenario)}: RMSE {np.degrees(result.metrics.rmse):.2f} deg"
+    labels = ["first"]
+    if compare is not None:
+        text = compare_label(compare_text or {})
+        title += f"; compare {text}: RMSE {np.degrees(compare.metrics.rmse):.2f} deg"
+        labels = [f"{result.scenario.controller}, {result.scenario.plant_name}", f"compare: {text}"]
+    write_page(path, scenes=scenes, frames=frames, rows=all_rows, title=title, labels=labels, fps=fps)

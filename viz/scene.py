@@ -15,8 +15,14 @@ what the MJCF has no geometry for:
 * an arrow along gravity.
 
 The joint is millimetres across and meshcat's camera orbits the world origin,
-so everything hangs under ``/twin``, drawn ``SCALE`` times larger with the
-output shaft at the origin, and meshcat's metre grid and axes are hidden.
+so everything hangs under ``/twin`` (compare mode's second joint under
+``/compare``, tinted, beside the first), drawn ``SCALE`` times larger with the
+middle of the mechanism at the origin, and meshcat's metre grid and axes are
+hidden. Each joint carries an invisible box, ``<root>/bodies/housing/view_box``,
+round its cylinders, racks, gears and the link's whole sweep: the pages fit the
+camera to those boxes (:func:`scene_commands` sets the direction: from above
+and in front). Gears are flat-shaded solids, the housing translucent so the
+pinion shows through it, the payload a brass sphere of its true size.
 Commands are meshcat's lowered dicts: :mod:`viz.recording` packs them into
 an HTML file, :mod:`viz.live_server` streams them to a browser.
 """
@@ -24,6 +30,7 @@ an HTML file, :mod:`viz.live_server` streams them to a browser.
 from __future__ import annotations
 
 import dataclasses
+from collections.abc import Sequence
 
 import meshcat.geometry as g
 import mujoco
@@ -54,10 +61,20 @@ GHOST_RGBA = (0.9, 0.9, 0.95, 0.35)
 GHOST_LIFT = 1.2e-3  # m along the shaft
 GRAVITY_ARROW_LENGTH = 12e-3  # m
 GRAVITY_ARROW_BASE = np.array([0.03, 0.02, 0.0])  # m, in the world, beside the joint
-SCENE_CENTRE = np.array([-0.01, 0.0, 0.0])  # m, mid-way between the valves and the swept link
-# Camera in meshcat's y-up "rotated" frame (x, world z, -world y), after SCALE: looking at
-# the plane the link turns in, from above (horizontal) or from the front (vertical).
-CAMERA_POSITION = {"horizontal": (0.0, 0.72, 0.3), "vertical": (0.0, 0.3, 0.72)}
+# Camera direction in the world (z up), toward the camera: from above and in front (horizontal, the
+# link turns in the x-y plane) or from in front and a little above (vertical, the x-z plane). Its
+# distance is fitted to the view boxes by the page; CAMERA_DISTANCE is the start before the fit.
+CAMERA_DIRECTION = {"horizontal": (0.0, -0.57, 0.82), "vertical": (0.0, -0.9, 0.42)}
+CAMERA_DISTANCE = 1.4  # m, in the drawn (SCALE times) scene
+VIEW_MARGIN = 1.5e-3  # m round the view box
+COMPARE_ROOT = "compare"
+COMPARE_TINT = np.array([0.1, 0.75, 0.8])  # teal, mixed into the second joint's solid parts
+COMPARE_TINT_SHARE = 0.6
+COMPARE_GAP = 10e-3  # m between the two joints' view boxes
+BRASS_RGBA = (0.78, 0.6, 0.2, 1.0)  # the payload: brass (SPEC §2; its size from params.masses.payload_density)
+
+SOLID_GEOMS = ("pinion_body", "spur_body", "rack_a_bar", "rack_b_bar", "link_beam", "payload_mass",
+               "cylinder_a_barrel", "cylinder_b_barrel", "rack_a_rod", "rack_b_rod", "pinion_mark")
 
 _Y_TO_Z = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, -1.0], [0.0, 1.0, 0.0]])  # Rx(+90 deg): three.js y -> z
 
@@ -74,9 +91,14 @@ def _colour(rgb) -> int:
     return (r << 16) | (gr << 8) | b
 
 
-def _material(rgba) -> g.MeshLambertMaterial:
+def _material(rgba, *, solid: bool = False) -> g.Material:
+    """Lambert (matte) by default; ``solid``: flat-shaded Phong, so a gear's faces read as faces."""
     opacity = float(rgba[3])
-    return g.MeshLambertMaterial(color=_colour(rgba), opacity=opacity, transparent=opacity < 1.0)
+    if solid:
+        return g.MeshPhongMaterial(color=_colour(rgba), opacity=opacity, transparent=opacity < 1.0,
+                                   flatShading=True, shininess=40, specular=0x333333)
+    return g.MeshLambertMaterial(color=_colour(rgba), opacity=opacity, transparent=opacity < 1.0,
+                                 depthWrite=opacity >= 1.0)
 
 
 def pressure_rgb(pressure: float, supply: float) -> tuple[float, float, float]:
@@ -94,38 +116,63 @@ class Frame:
 
 
 class JointScene:
-    """The meshcat scene of one compiled joint; see the module docstring."""
+    """The meshcat scene of one compiled joint under ``/root``; see the module docstring.
+    ``tint``: an rgb mixed into its solid parts (compare mode's second joint)."""
 
-    def __init__(self, joint: JointModel, *, supply_pressure: float):
+    def __init__(self, joint: JointModel, *, supply_pressure: float, root: str = ROOT.strip("/"),
+                 tint=None):
         self.joint = joint
         self.model = joint.model
         self.supply = supply_pressure  # Pa, for the chamber colour scale
+        self.root, self.tint = root, tint
         self.kinematics = mujoco.MjData(self.model)  # poses of replayed states
         self.ghost_data = mujoco.MjData(self.model)  # poses at the desired angle
         self.body_names = [self.model.body(b).name for b in range(1, self.model.nbody)]
         self.link_body = self.model.body("link").id
         self.housing_body = self.model.body("housing").id
+        mujoco.mj_kinematics(self.model, self.kinematics)
 
     # -- the scene, sent once ------------------------------------------------
+    def view_box(self) -> tuple[np.ndarray, np.ndarray]:
+        """Corners (m, housing frame) of the box the camera keeps in view: the cylinders and valves,
+        the racks and gears, and the link with its payload over the racks' whole travel."""
+        m, data = self.model, self.kinematics
+        low, high = np.full(3, np.inf), np.full(3, -np.inf)
+        for name in ("cylinder_a_barrel", "cylinder_b_barrel"):
+            geom = m.geom(name).id
+            centre, half = m.geom_pos[geom], float(m.geom_size[geom][1])
+            low, high = np.minimum(low, centre - [half, 0, 0]), np.maximum(high, centre + [half, 0, 0])
+        for x, y, z in VALVE_POSITIONS.values():
+            low, high = np.minimum(low, [x - VALVE_RADIUS, y - VALVE_RADIUS, z]), np.maximum(high, [x, y, z])
+        payload = m.geom("payload_mass").id
+        reach_out = float(m.geom_size[payload][0]) if self._rgba(payload)[3] > 0 else 0.0
+        housing = data.xmat[self.housing_body].reshape(3, 3), data.xpos[self.housing_body].copy()
+        travel = m.jnt_range[m.body_jntadr[m.body("rack_a").id]]
+        for y in np.linspace(travel[0], travel[1], 49):  # the link's sweep, through MuJoCo's kinematics
+            self._place(data, float(y))
+            mujoco.mj_kinematics(m, data)
+            tip = housing[0].T @ (data.xpos[m.body("payload").id] - housing[1])
+            low, high = np.minimum(low, tip - reach_out), np.maximum(high, tip + reach_out)
+        shell = m.geom("housing_shell").id
+        low[2] = min(low[2], -m.geom_size[shell][2])
+        return low - VIEW_MARGIN, high + VIEW_MARGIN
+
     def setup_commands(self) -> list[dict]:
-        """Objects, their fixed offsets, the camera and the hidden grid: send once per model."""
-        commands = [SetProperty("visible", False, Path(("Grid",))).lower(),
-                    SetProperty("visible", False, Path(("Axes",))).lower(),
-                    SetTransform(_homogeneous(SCALE * np.eye(3), -SCALE * SCENE_CENTRE), Path(("twin",))).lower()]
-        camera = CAMERA_POSITION[self.joint.orientation.value]
-        commands.append(SetProperty("position", list(camera),
-                                    Path(("Cameras", "default", "rotated", "<object>"))).lower())
+        """This joint's objects and their fixed offsets: send once per model (after
+        :func:`scene_commands`'s camera and placement, or use that)."""
+        commands = []
         for geom in range(self.model.ngeom):
             rgba = self._rgba(geom)
             if rgba[3] <= 0.0:
                 continue  # the empty payload's placeholder
             body = self.body_names[self.model.geom_bodyid[geom] - 1]
-            path = Path(("twin", "bodies", body, self.model.geom(geom).name))
+            path = Path((self.root, "bodies", body, self.model.geom(geom).name))
             geometry, offset = self._geometry(geom)
-            commands.append(SetObject(geometry, _material(rgba), path).lower())
+            solid = self.model.geom(geom).name in SOLID_GEOMS
+            commands.append(SetObject(geometry, _material(self._tinted(rgba), solid=solid), path).lower())
             commands.append(SetTransform(offset, path).lower())
             if body == "link":  # the ghost floats just above the link so the two never z-fight
-                ghost = Path(("twin", "ghost", self.model.geom(geom).name))
+                ghost = Path((self.root, "ghost", self.model.geom(geom).name))
                 lifted = offset.copy()
                 lifted[2, 3] += GHOST_LIFT
                 commands.append(SetObject(geometry, _material(GHOST_RGBA), ghost).lower())
@@ -133,18 +180,32 @@ class JointScene:
         for name, (barrel, _) in CHAMBERS.items():
             radius = 1.1 * float(self.model.geom_size[self.model.geom(barrel).id][0])
             commands.append(SetObject(g.Cylinder(1.0, radius), _material((*LOW_PRESSURE_RGB, 0.85)),
-                                      Path(("twin", "chambers", name))).lower())
+                                      Path((self.root, "chambers", name))).lower())
         for name in VALVES:
             commands.append(SetObject(g.Sphere(VALVE_RADIUS), _material((*VALVE_SHUT_RGB, 1.0)),
-                                      Path(("twin", "bodies", "housing", "valves", name))).lower())
+                                      Path((self.root, "bodies", "housing", "valves", name))).lower())
             commands.append(SetTransform(_homogeneous(np.eye(3), np.array(VALVE_POSITIONS[name])),
-                                         Path(("twin", "bodies", "housing", "valves", name))).lower())
+                                         Path((self.root, "bodies", "housing", "valves", name))).lower())
+        low, high = self.view_box()
+        box = Path((self.root, "bodies", "housing", "view_box"))
+        commands.append(SetObject(g.Box(list(high - low)), _material((1.0, 1.0, 1.0, 1.0)), box).lower())
+        commands.append(SetTransform(_homogeneous(np.eye(3), (low + high) / 2), box).lower())
+        commands.append(SetProperty("visible", False, box).lower())
         commands.extend(self._gravity_arrow())
         return commands
 
+    def _tinted(self, rgba) -> tuple:
+        if self.tint is None:
+            return tuple(rgba)
+        rgb = (1.0 - COMPARE_TINT_SHARE) * np.asarray(rgba[:3]) + COMPARE_TINT_SHARE * np.asarray(self.tint)
+        return (*rgb, rgba[3])
+
     def _rgba(self, geom: int) -> np.ndarray:
         material = self.model.geom_matid[geom]
-        return self.model.mat_rgba[material] if material >= 0 else self.model.geom_rgba[geom]
+        rgba = self.model.mat_rgba[material] if material >= 0 else self.model.geom_rgba[geom]
+        if self.model.geom(geom).name == "payload_mass" and rgba[3] > 0:
+            return np.array(BRASS_RGBA)  # the model's grey marks it; the part is brass
+        return rgba
 
     def _geometry(self, geom: int) -> tuple[g.Geometry, np.ndarray]:
         """A meshcat geometry for a MuJoCo geom and its transform in the body frame."""
@@ -195,12 +256,12 @@ class JointScene:
         base = GRAVITY_ARROW_BASE
         grey = _material((0.3, 0.3, 0.3, 1.0))
         return [
-            SetObject(g.Cylinder(shaft, 0.4e-3), grey, Path(("twin", "gravity", "shaft"))).lower(),
-            SetTransform(_homogeneous(rotation, base - up * shaft / 2), Path(("twin", "gravity", "shaft"))).lower(),
+            SetObject(g.Cylinder(shaft, 0.4e-3), grey, Path((self.root, "gravity", "shaft"))).lower(),
+            SetTransform(_homogeneous(rotation, base - up * shaft / 2), Path((self.root, "gravity", "shaft"))).lower(),
             SetObject(g.Cylinder(head, radiusTop=1.2e-3, radiusBottom=0.0), grey,
-                      Path(("twin", "gravity", "head"))).lower(),
+                      Path((self.root, "gravity", "head"))).lower(),
             SetTransform(_homogeneous(rotation, base - up * (shaft + head / 2)),
-                         Path(("twin", "gravity", "head"))).lower(),
+                         Path((self.root, "gravity", "head"))).lower(),
         ]
 
     # -- a frame, sent as often as the picture changes -----------------------
@@ -208,15 +269,16 @@ class JointScene:
               valve_open) -> Frame:
         """The poses in ``data`` (kinematics done), the ghost at ``desired_angle`` (rad), the
         chamber pressures (Pa) and valves V1-V4 (bool) as one :class:`Frame`."""
-        transforms = {f"{ROOT}/bodies/{name}": _homogeneous(data.xmat[b].reshape(3, 3), data.xpos[b])
+        root = "/" + self.root
+        transforms = {f"{root}/bodies/{name}": _homogeneous(data.xmat[b].reshape(3, 3), data.xpos[b])
                       for b, name in enumerate(self.body_names, start=1)}
-        transforms[f"{ROOT}/ghost"] = self._ghost_pose(desired_angle)
+        transforms[f"{root}/ghost"] = self._ghost_pose(desired_angle)
         colours = {}
         for (name, (barrel, rod)), pressure in zip(CHAMBERS.items(), pressures, strict=True):
-            transforms[f"{ROOT}/chambers/{name}"] = self._chamber_pose(data, barrel, rod)
-            colours[f"{ROOT}/chambers/{name}/<object>"] = pressure_rgb(float(pressure), self.supply)
+            transforms[f"{root}/chambers/{name}"] = self._chamber_pose(data, barrel, rod)
+            colours[f"{root}/chambers/{name}/<object>"] = pressure_rgb(float(pressure), self.supply)
         for name, is_open in zip(VALVES, valve_open, strict=True):
-            colours[f"{ROOT}/bodies/housing/valves/{name}/<object>"] = (
+            colours[f"{root}/bodies/housing/valves/{name}/<object>"] = (
                 VALVE_OPEN_RGB if is_open else VALVE_SHUT_RGB)
         return Frame(transforms=transforms, colours=colours)
 
@@ -248,6 +310,45 @@ class JointScene:
         piston = data.geom_xpos[r] - data.geom_xmat[r].reshape(3, 3)[:, 2] * self.model.geom_size[r][1]
         length = max(float(np.dot(piston - closed_end, axis)), 0.5e-3)
         return _homogeneous(barrel_axes @ _Y_TO_Z, closed_end + axis * length / 2, scale=(1.0, length, 1.0))
+
+
+def _world_box(scene: JointScene) -> tuple[np.ndarray, np.ndarray]:
+    low, high = scene.view_box()
+    rotation = scene.kinematics.xmat[scene.housing_body].reshape(3, 3)
+    origin = scene.kinematics.xpos[scene.housing_body]
+    corners = np.array([[x, y, z] for x in (low[0], high[0]) for y in (low[1], high[1]) for z in (low[2], high[2])])
+    world = corners @ rotation.T + origin
+    return world.min(axis=0), world.max(axis=0)
+
+
+def placement(scenes: Sequence[JointScene]) -> list[np.ndarray]:
+    """Where each joint's origin sits in the world (m, before SCALE) so that the first is beside the
+    second along the first housing's -y (in its plane of rotation) and the pair is centred."""
+    boxes = [_world_box(scene) for scene in scenes]
+    across = -scenes[0].kinematics.xmat[scenes[0].housing_body].reshape(3, 3)[:, 1]
+    offsets = [np.zeros(3)]
+    for low, high in boxes[1:]:
+        first_low, first_high = boxes[0]
+        offsets.append(across * (float(np.abs(across) @ (first_high - first_low)) / 2
+                                 + float(np.abs(across) @ (high - low)) / 2 + COMPARE_GAP))
+    low = np.min([box[0] + offset for box, offset in zip(boxes, offsets, strict=True)], axis=0)
+    high = np.max([box[1] + offset for box, offset in zip(boxes, offsets, strict=True)], axis=0)
+    centre = (low + high) / 2
+    return [offset - centre for offset in offsets]
+
+
+def scene_commands(scenes: Sequence[JointScene]) -> list[dict]:
+    """The whole scene: meshcat's grid and axes hidden, the camera's direction (from above and in
+    front of the first joint's plane of rotation), each joint placed (:func:`placement`) and drawn."""
+    commands = [SetProperty("visible", False, Path(("Grid",))).lower(),
+                SetProperty("visible", False, Path(("Axes",))).lower()]
+    x, y, z = CAMERA_DISTANCE * np.array(CAMERA_DIRECTION[scenes[0].joint.orientation.value])
+    commands.append(SetProperty("position", [float(x), float(z), float(-y)],  # meshcat's y-up camera frame
+                                Path(("Cameras", "default", "rotated", "<object>"))).lower())
+    for scene, origin in zip(scenes, placement(scenes), strict=True):
+        commands.append(SetTransform(_homogeneous(SCALE * np.eye(3), SCALE * origin), Path((scene.root,))).lower())
+        commands.extend(scene.setup_commands())
+    return commands
 
 
 def rack_teeth_layout(*, travel: tuple[float, float], teeth: int, pinion_radius: float, module: float,

@@ -174,7 +174,7 @@ def test_recording_writes_one_offline_file(tmp_path):
     write_recording(result, path)
     text = path.read_text()
     assert "http://" not in text.split("<script>")[0] and 'src="http' not in text  # nothing fetched
-    assert "MeshCat" in text and "data:image/png;base64," in text
+    assert "MeshCat" in text and "StripChart" in text  # the scene and the chart drawer, inlined
     trace = json.loads(text.split("window.twinTrace = ")[1].split(";\n")[0])
     assert trace["time"][1] - trace["time"][0] == pytest.approx(0.02)
     assert trace["angle_deg"][-1] == pytest.approx(math.degrees(result.trace.angle[-1]), abs=1e-9)

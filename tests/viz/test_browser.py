@@ -74,22 +74,22 @@ def screenshot(page, name: str) -> np.ndarray:
     return image[int(box["y"]):int(box["y"] + box["height"]), int(box["x"]):int(box["x"] + box["width"])]
 
 
-def assert_scene_rendered(pixels: np.ndarray) -> None:
-    """Not blank: the link's red and the gears' brass are on the screen."""
+def assert_scene_rendered(pixels: np.ndarray, least: int = 300) -> None:
+    """Not blank: the link's red and the gears' brass are on the screen (``least`` pixels of each)."""
     r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
     red = (r > 70) & (r > 2 * g) & (r > 2 * b)
     brass = (r > 90) & (g > 0.55 * r) & (b < 0.5 * g)
-    assert red.sum() > 300, f"only {red.sum()} red pixels (link)"
-    assert brass.sum() > 300, f"only {brass.sum()} brass pixels (gears, racks)"
+    assert red.sum() > least, f"only {red.sum()} red pixels (link)"
+    assert brass.sum() > least, f"only {brass.sum()} brass pixels (gears, racks)"
 
 
 def wait_for_animation(page) -> None:
     page.wait_for_function("window.viewer && viewer.animator.actions.length > 0", timeout=60_000)
 
 
-def body_rotation(page, body: str) -> np.ndarray:
+def body_rotation(page, body: str, root: str = "twin") -> np.ndarray:
     """The 3x3 rotation of a body's node as three.js holds it (its ``matrix``, refreshed from its pose)."""
-    elements = page.evaluate(f"(() => {{ const o = viewer.scene_tree.find(['twin', 'bodies', '{body}']).object; "
+    elements = page.evaluate(f"(() => {{ const o = viewer.scene_tree.find(['{root}', 'bodies', '{body}']).object; "
                              "o.updateMatrix(); return Array.from(o.matrix.elements); })()")
     return np.array(elements).reshape(4, 4).T[:3, :3]
 
@@ -110,12 +110,39 @@ def quaternion_turn(a: np.ndarray, b: np.ndarray) -> float:
     return math.degrees(2.0 * math.acos(min(1.0, abs(float(np.dot(a, b))))))
 
 
+def chart_pixels(page, chart: str, rgb: tuple[int, int, int], tolerance: int = 40) -> int:
+    """How many pixels of strip chart ``chart``'s canvas are within ``tolerance`` of colour ``rgb``."""
+    return page.evaluate(f"""(() => {{
+        const c = document.querySelector('canvas[data-chart="{chart}"]');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4)
+            if (Math.abs(d[i] - {rgb[0]}) + Math.abs(d[i + 1] - {rgb[1]}) + Math.abs(d[i + 2] - {rgb[2]}) < {tolerance}) n++;
+        return n; }})()""")
+
+
+def cursor_column(page, chart: str) -> float:
+    """The CSS x (from the canvas's left) of the chart's red cursor: the column with most cursor-red pixels."""
+    return page.evaluate(f"""(() => {{
+        const c = document.querySelector('canvas[data-chart="{chart}"]');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        const counts = new Array(c.width).fill(0);
+        for (let i = 0; i < d.length; i += 4)
+            if (d[i] > 180 && d[i + 1] < 60 && d[i + 2] < 60) counts[(i / 4) % c.width]++;
+        const best = counts.indexOf(Math.max(...counts));
+        return best / (c.width / c.clientWidth); }})()""")
+
+
+TEAL = (18, 165, 176)  # the compare joint's trace colour (viz/strip_chart.js TWIN_COMPARE_TINT)
+ANGLE_RED = (192, 57, 43)  # the first joint's angle trace
+
+
 @pytest.mark.slow  # over ~2.5 s on 2 cores
-def test_recording_plays_offline_and_moves_by_the_trace(tmp_path, page):
+def test_recording_controls_seek_the_view_and_the_cursor_together(tmp_path, page):
     html, trace = tmp_path / "out.html", tmp_path / "out.csv"
     proc = subprocess.run(
         [sys.executable, "-m", "twin", "run", "--controller", "ffpva", "--trajectory", "1", "--payload", "13.5",
-         "--orientation", "vertical", "--html", str(html), "--trace", str(trace)],
+         "--orientation", "vertical", "--html", str(html), "--trace", str(trace), "--compare", "controller=smc"],
         cwd=tmp_path, env=twin_env(), capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     with open(trace) as handle:
@@ -124,11 +151,17 @@ def test_recording_plays_offline_and_moves_by_the_trace(tmp_path, page):
     page.route("**/*", lambda route: route.abort() if not route.request.url.startswith("file:") else route.continue_())
     page.goto(html.as_uri())
     wait_for_animation(page)
-    poses = {}
+    page.wait_for_function("window.twinPlots && window.twinPlots.draws > 2", timeout=30_000)
+    page.click("#play")  # the page's own pause
+    assert page.evaluate("window.twinClock.playing") is False
+    poses, cursors = {}, {}
     for t in (0.4, 0.6):
-        page.evaluate(f"viewer.animator.pause(); viewer.animator.seek({t});")
-        page.wait_for_timeout(400)  # a render, for the screenshot
+        page.evaluate(f"const s = document.getElementById('scrub'); s.value = {t}; s.dispatchEvent(new Event('input'));")
+        page.wait_for_timeout(500)  # renders, for the screenshot and the chart
+        assert page.evaluate("window.twinClock.time") == pytest.approx(t, abs=1e-3)
         poses[t] = {body: body_rotation(page, body) for body in ("spur", "link", "pinion")}
+        cursors[t] = cursor_column(page, "angle")
+        assert cursors[t] == pytest.approx(page.evaluate(f"window.twinPlots.xOf('angle', {t})"), abs=2.0)
         if t == 0.6:
             assert_scene_rendered(screenshot(page, "recording.png"))
     row = {t: rows[int(round(t * 1000))] for t in poses}
@@ -140,20 +173,50 @@ def test_recording_plays_offline_and_moves_by_the_trace(tmp_path, page):
     assert turned(poses[0.4]["spur"], poses[0.6]["spur"]) == pytest.approx(output, abs=0.5)
     assert turned(poses[0.4]["link"], poses[0.6]["link"]) == pytest.approx(output, abs=0.5)
     assert turned(poses[0.4]["pinion"], poses[0.6]["pinion"]) == pytest.approx(pinion, abs=0.5)
+    width = page.evaluate("document.querySelector('canvas[data-chart=\"angle\"]').clientWidth")
+    duration = page.evaluate("window.twinTrace.time[window.twinTrace.time.length - 1]")
+    assert cursors[0.6] - cursors[0.4] == pytest.approx(0.2 / duration * (width - 48), abs=2.5)  # plot width: 48 px of axes
+    # compare mode: the second joint is drawn and its traces overlaid
+    assert page.evaluate("window.twinTraces.length") == 2
+    assert chart_pixels(page, "angle", TEAL) > 100 and chart_pixels(page, "angle", ANGLE_RED) > 30  # mostly under the teal
+    compare_link = body_rotation(page, "link", root="compare")
+    assert turned(compare_link, poses[0.6]["link"]) < 20.0  # same trajectory, another controller
+    # speed: 2x plays twice as fast as the wall clock
+    page.select_option("#speed", "2")
+    page.evaluate("const s = document.getElementById('scrub'); s.value = 0; s.dispatchEvent(new Event('input'));")
+    page.click("#play")
+    start = page.evaluate("[window.twinClock.time, performance.now()]")
+    page.wait_for_timeout(1000)
+    end = page.evaluate("[window.twinClock.time, performance.now()]")
+    assert (end[0] - start[0]) / ((end[1] - start[1]) / 1000) == pytest.approx(2.0, abs=0.6)
+
+
+def start_twin(*flags: str):
+    ARTIFACTS.mkdir(exist_ok=True)
+    log = open(ARTIFACTS / "twin-view.stderr.txt", "w")  # read when a test fails; never a full pipe
+    proc = subprocess.Popen([sys.executable, "-m", "twin", "view", "--port", "0", "--duration", "900", *flags],
+                            cwd=ROOT, env=twin_env(), stdout=subprocess.PIPE, stderr=log, text=True)
+    line = proc.stdout.readline()
+    match = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
+    assert match, f"no URL in {line!r}; stderr: {(ARTIFACTS / 'twin-view.stderr.txt').read_text()}"
+    return proc, log, match.group(0), int(match.group(1))
 
 
 @pytest.fixture
 def live_twin():
-    ARTIFACTS.mkdir(exist_ok=True)
-    log = open(ARTIFACTS / "twin-view.stderr.txt", "w")  # read when a test fails; never a full pipe
-    proc = subprocess.Popen(
-        [sys.executable, "-m", "twin", "view", "--controller", "smc", "--trajectory", "4", "--port", "0",
-         "--duration", "900"],
-        cwd=ROOT, env=twin_env(), stdout=subprocess.PIPE, stderr=log, text=True)
-    line = proc.stdout.readline()
-    match = re.search(r"http://127\.0\.0\.1:(\d+)/", line)
-    assert match, f"no URL in {line!r}; stderr: {(ARTIFACTS / 'twin-view.stderr.txt').read_text()}"
-    yield proc, match.group(0), int(match.group(1))
+    proc, log, url, port = start_twin("--controller", "smc", "--trajectory", "4")
+    yield proc, url, port
+    if proc.poll() is None:
+        proc.kill()
+        proc.wait(10)
+    log.close()
+
+
+@pytest.fixture
+def compare_twin():
+    proc, log, url, port = start_twin("--controller", "ffpva", "--trajectory", "1",
+                                      "--compare", "controller=smc,payload=13.5")
+    yield proc, url, port
     if proc.poll() is None:
         proc.kill()
         proc.wait(10)
@@ -174,27 +237,91 @@ def wait_until(page, condition, timeout: float = 180.0, what: str = "") -> dict:
     raise AssertionError(f"timed out waiting for {what}; last readout {readout(page)}")
 
 
+def slider(page) -> float:
+    return float(page.evaluate("document.getElementById('target').value"))
+
+
+def view_fit(page) -> dict:
+    """Where the joints' view boxes fall in the 3D canvas (normalised device coordinates, -1..1) and
+    the canvas's and pane's sizes."""
+    return page.evaluate("""(() => {
+        const boxes = twinViewBoxes(viewer);
+        const xs = [], ys = [];
+        for (const b of boxes) for (const x of [b.min.x, b.max.x]) for (const y of [b.min.y, b.max.y])
+            for (const z of [b.min.z, b.max.z]) {
+                const p = new MeshCat.THREE.Vector3(x, y, z).project(viewer.camera); xs.push(p.x); ys.push(p.y); }
+        const pane = document.getElementById('meshcat-pane').getBoundingClientRect();
+        const canvas = viewer.renderer.domElement.getBoundingClientRect();
+        const panel = document.getElementById('panel').getBoundingClientRect();
+        return {boxes: boxes.length, x: [Math.min(...xs), Math.max(...xs)], y: [Math.min(...ys), Math.max(...ys)],
+                pane: [pane.width, pane.height], canvas: [canvas.width, canvas.height], panel: panel.width}; })()""")
+
+
+def assert_fills(fit: dict) -> None:
+    """Every corner of the view boxes inside the canvas, and the boxes filling most of one direction."""
+    assert fit["boxes"] >= 1
+    assert -1.0 <= fit["x"][0] and fit["x"][1] <= 1.0 and -1.0 <= fit["y"][0] and fit["y"][1] <= 1.0, fit
+    assert max(fit["x"][1] - fit["x"][0], fit["y"][1] - fit["y"][0]) > 1.7, fit  # over 85 % of the width or height
+    assert fit["canvas"][0] == pytest.approx(fit["pane"][0], abs=1) and fit["canvas"][1] == pytest.approx(fit["pane"][1], abs=1)
+
+
 @pytest.mark.slow  # over ~2.5 s on 2 cores
-def test_live_page_follows_the_slider_and_refuses_bad_messages(live_twin, page):
+def test_live_page_plots_follows_the_server_and_reflows(live_twin, browser, page):
     proc, url, port = live_twin
     assert listening_addresses(port) == {"127.0.0.1"}
+    page.set_viewport_size({"width": 1280, "height": 720})
     page.goto(url)
     page.wait_for_function("window.twinLast !== null && window.twinState !== undefined", timeout=60_000)
-    wait_until(page, lambda r: r["time"] > 6.3, what="T4 to finish (6 s)")
+    # the first page to connect replays T1 (the twin was started on T4): the joint moves on open
+    assert page.evaluate("window.twinState.playing") == "T1"
+    assert page.evaluate("window.twinState.target_deg") == pytest.approx(150.0)
+    assert_fills(view_fit(page))
+
+    # the plots update while the joint moves: 20+ redraws a second, and the pixels change
+    wait_until(page, lambda r: abs(r["desired_deg"] - r["angle_deg"]) < 5 and 40 < r["desired_deg"] < 140,
+               what="T1 under way")
+    before = page.evaluate("[window.twinPlots.draws, performance.now()]")
+    image = page.evaluate("document.querySelector('canvas[data-chart=\"angle\"]').toDataURL()")
+    page.wait_for_timeout(2000)
+    after = page.evaluate("[window.twinPlots.draws, performance.now()]")
+    assert (after[0] - before[0]) / ((after[1] - before[1]) / 1000) >= 20.0
+    assert page.evaluate("document.querySelector('canvas[data-chart=\"angle\"]').toDataURL()") != image
+    for chart, colour in (("angle", ANGLE_RED), ("duty", (36, 113, 163)), ("pressure", (211, 84, 0)),
+                          ("valves", (44, 160, 44))):
+        assert chart_pixels(page, chart, colour) > 20, chart
+
+    # after the T1 replay the slider shows the current target, here and in a second tab
+    wait_until(page, lambda r: r["time"] > 4.0 and abs(r["angle_deg"] - 150.0) < 1.5, what="T1 to end at 150 deg")
+    assert slider(page) == 150.0
+    other = browser.new_page(viewport={"width": 800, "height": 600})
+    other.goto(url)
+    other.wait_for_function("window.twinState !== undefined && window.twinLast !== null", timeout=60_000)
+    assert slider(other) == 150.0
     link = ["twin", "bodies", "link"]
     before, angle_before = body_quaternion(page, link), readout(page)["angle_deg"]
-    assert angle_before == pytest.approx(30.0, abs=1.5)
-    assert_scene_rendered(screenshot(page, "live-start.png"))
-
-    page.evaluate("const t = document.getElementById('target'); t.value = 120; t.dispatchEvent(new Event('input'));")
+    other.evaluate("const t = document.getElementById('target'); t.value = 120; t.dispatchEvent(new Event('input'));")
+    page.wait_for_function("window.twinState.target_deg === 120", timeout=10_000)
+    assert slider(page) == 120.0
     started = readout(page)["time"]
     settled = wait_until(page, lambda r: r["time"] > started + 1.5 and abs(r["angle_deg"] - 120.0) < 1.0,
                          what="the joint to reach the slider's 120 deg")
-    after = body_quaternion(page, link)
-    angle_after = readout(page)["angle_deg"]
     assert settled["desired_deg"] == pytest.approx(120.0)
-    assert quaternion_turn(before, after) == pytest.approx(angle_after - angle_before, abs=1.0)
-    assert_scene_rendered(screenshot(page, "live-120deg.png"))
+    after = body_quaternion(page, link)
+    assert quaternion_turn(before, after) == pytest.approx(abs(readout(page)["angle_deg"] - angle_before), abs=1.0)
+    other.close()
+    page.wait_for_timeout(300)
+    pixels = screenshot(page, "live-120deg.png")
+    assert_scene_rendered(pixels)
+    shutil.copy(ARTIFACTS / "live-120deg.png", ROOT / "docs" / "viewer.png")  # the docs' picture, 1280x720
+
+    # 800x600 after a resize: the panel stays usable and the 3D view still shows the whole mechanism
+    page.set_viewport_size({"width": 800, "height": 600})
+    page.wait_for_timeout(600)
+    fit = view_fit(page)
+    assert fit["panel"] >= 240
+    assert_fills(fit)
+    assert_scene_rendered(screenshot(page, "live-800x600.png"), least=120)  # a smaller view
+    assert page.evaluate("document.querySelector('canvas[data-chart=\"angle\"]').clientWidth") > 150
 
     for bad in ['{"type": "payload", "grams": 51}', "not json", '{"type": "target", "angle_deg": -5}',
                 '{"type": "trajectory", "number": "T9"}']:
@@ -212,18 +339,64 @@ def test_live_page_follows_the_slider_and_refuses_bad_messages(live_twin, page):
     page.evaluate("window.twinSocket.close()")  # a dropped connection, the twin still running
     page.wait_for_function("document.getElementById('state').textContent.startsWith('connection lost')",
                            timeout=5_000)
+    assert page.evaluate("window.twinConnection") == "lost"
     page.wait_for_function("window.twinSocket.readyState === WebSocket.OPEN", timeout=15_000)
     back = readout(page)["time"]
     wait_until(page, lambda r: r["time"] > back + 0.5, what="readouts again after reconnecting")
+    assert page.evaluate("window.twinState.playing") == "target 120 deg"  # a reconnect replays nothing
 
     page.select_option("#orientation", "vertical")  # rebuild and restart
     page.wait_for_function("window.twinState.orientation === 'vertical'", timeout=30_000)
     wait_until(page, lambda r: r["time"] < 2.0, what="the restarted run")
     page.click("text=T1")
     wait_until(page, lambda r: r["desired_deg"] > 100.0, what="T1's replay to rise")
-    assert_scene_rendered(screenshot(page, "live-vertical.png"))
+    page.wait_for_timeout(600)
+    assert_fills(view_fit(page))
+    assert_scene_rendered(screenshot(page, "live-vertical.png"), least=60)  # 800x600, gears seen edge-on
 
-    proc.send_signal(signal.SIGINT)
+    proc.send_signal(signal.SIGINT)  # the twin stops: the page says so (not "connection lost")
+    page.wait_for_function("window.twinConnection === 'stopped'", timeout=10_000)
+    assert "the twin stopped" in page.inner_text("#state")
     out, err = proc.communicate(timeout=60)
     assert proc.returncode == 0, err
     assert "twin view: stopped" in out
+
+
+@pytest.mark.slow  # over ~2.5 s on 2 cores
+def test_compare_mode_draws_two_joints_and_two_traces(compare_twin, page):
+    proc, url, port = compare_twin
+    page.set_viewport_size({"width": 1280, "height": 720})
+    page.goto(url)
+    page.wait_for_function("window.twinLast !== null && window.twinState !== undefined", timeout=60_000)
+    state = page.evaluate("window.twinState")
+    assert state["compare"]["settings"] == {"controller": "smc", "payload": "13.5"}
+    assert state["compare"]["controller"] == "smc" and state["compare"]["payload_g"] == pytest.approx(13.5)
+    assert state["controller"] == "ffpva" and state["payload_g"] == 0
+    wait_until(page, lambda r: r["time"] > 3.0 and r["desired_deg"] > 100, what="T1 replayed on both")
+    last = readout(page)
+    assert last["compare_angle_deg"] == pytest.approx(last["angle_deg"], abs=10.0)  # same targets, same time
+    # two joints: the second's link turned by its own angle, beside the first
+    first = np.array(page.evaluate("viewer.scene_tree.find(['twin']).object.position.toArray()"))
+    second = np.array(page.evaluate("viewer.scene_tree.find(['compare']).object.position.toArray()"))
+    assert np.linalg.norm(first - second) > 0.5  # drawn 10x: over 50 mm apart
+    wait_until(page, lambda r: r["time"] > 4.5, what="T1 to end")
+    page.wait_for_timeout(400)
+    last = readout(page)
+    link = body_rotation(page, "link")
+    compare_link = body_rotation(page, "link", root="compare")
+    rest = body_rotation(page, "housing")  # the link's angle is measured from the housing frame
+    assert turned(rest, link) == pytest.approx(abs(last["angle_deg"]), abs=2.0)
+    assert turned(rest, compare_link) == pytest.approx(abs(last["compare_angle_deg"]), abs=2.0)
+    assert_fills(view_fit(page))
+    assert view_fit(page)["boxes"] == 2
+    pixels = screenshot(page, "live-compare.png")
+    assert_scene_rendered(pixels)
+    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
+    teal = (g > 110) & (b > 110) & (r < 0.6 * g)
+    assert teal.sum() > 300, f"only {teal.sum()} teal pixels (the compare joint)"
+    shutil.copy(ARTIFACTS / "live-compare.png", ROOT / "docs" / "viewer-compare.png")
+    # two traces in every line chart, with a legend naming the second
+    for chart in ("angle", "error", "duty", "pressure", "valves"):
+        assert chart_pixels(page, chart, TEAL) > 20, chart
+    assert page.evaluate("window.twinPlots.labels") == ["ffpva", "compare"]
+    assert "controller=smc, payload=13.5" in page.inner_text("#compare-info")

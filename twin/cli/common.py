@@ -39,6 +39,73 @@ def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"as-built effects to switch off ({', '.join(EFFECTS)}); only with --plant as-built")
 
 
+# --compare KEY=VALUE: the scenario flags a second joint may change (not --trajectory: both joints
+# share the targets and replays), each checked by its own flag's type; a Scenario field per key.
+COMPARE_FIELDS = {"controller": "controller", "plant": "plant", "payload": "payload", "orientation": "orientation",
+                  "seed": "seed", "noise": "noise", "supply-kpa": "supply_pressure", "without": "plant"}
+
+
+def _flag_parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(add_help=False, exit_on_error=False)
+    add_scenario_arguments(parser)
+    return parser
+
+
+def compare_settings(text: str) -> dict[str, str]:
+    """``--compare KEY=VALUE[,KEY=VALUE]``: the user's settings, each value checked by the scenario
+    flag of the same name (``noise=on|off``; ``without=EFFECT[+EFFECT]``)."""
+    settings: dict[str, str] = {}
+    for item in (part.strip() for part in text.split(",")):
+        key, equals, value = item.partition("=")
+        key, value = key.strip(), value.strip()
+        if not equals or not key or not value:
+            raise argparse.ArgumentTypeError(f"expected KEY=VALUE[,KEY=VALUE], got {item!r}")
+        if key not in COMPARE_FIELDS:
+            why = "both joints share it" if key == "trajectory" else f"choose from {', '.join(COMPARE_FIELDS)}"
+            raise argparse.ArgumentTypeError(f"key {key!r} cannot be compared: {why}")
+        if key in settings:
+            raise argparse.ArgumentTypeError(f"key {key!r} given twice")
+        _flag_values({key: value})  # raises with the flag's own reason
+        settings[key] = value
+    return settings
+
+
+def _flag_values(settings: dict[str, str]) -> argparse.Namespace:
+    """The scenario flags' namespace for ``settings`` (on top of the required flags' placeholders)."""
+    argv = ["--controller", "ffpva", "--trajectory", "1"]
+    for key, value in settings.items():
+        if key == "noise":
+            if value not in ("on", "off"):
+                raise argparse.ArgumentTypeError(f"key 'noise': expected on or off, got {value!r}")
+            argv.append("--noise" if value == "on" else "--no-noise")
+        else:
+            argv += [f"--{key}", value.replace("+", ",") if key == "without" else value]
+    try:
+        namespace, rest = _flag_parser().parse_known_args(argv)
+    except argparse.ArgumentError as error:
+        raise argparse.ArgumentTypeError(f"key {error.argument_name.lstrip('-')!r}: {error.message}") from None
+    if rest:
+        raise argparse.ArgumentTypeError(f"cannot read {' '.join(rest)!r}")
+    return namespace
+
+
+def compare_of(args: argparse.Namespace, settings: dict[str, str]):
+    """:class:`twin.envs.live.Compare` for ``settings`` on top of the command's scenario flags."""
+    from twin.envs.live import Compare
+
+    parsed = _flag_values(settings)
+    merged = argparse.Namespace(**vars(args))
+    for key in settings:
+        dest = key.replace("-", "_")
+        setattr(merged, dest, getattr(parsed, dest))
+    try:
+        scenario = scenario_from(merged)
+    except InvalidScenario as error:
+        raise InvalidScenario(f"--compare {','.join(f'{k}={v}' for k, v in settings.items())}: {error}") from None
+    changes = {COMPARE_FIELDS[key]: getattr(scenario, COMPARE_FIELDS[key]) for key in settings}
+    return Compare(changes=changes, text=dict(settings))
+
+
 def effects(text: str) -> tuple[str, ...]:
     names = tuple(sorted({name.strip() for name in text.split(",") if name.strip()}))
     unknown = [name for name in names if name not in EFFECTS]

@@ -5,15 +5,30 @@ from __future__ import annotations
 import argparse
 import json
 
-from twin.cli.common import add_scenario_arguments, all_or_nothing, say_written, scenario_from
+from twin.cli.common import (
+    add_scenario_arguments,
+    all_or_nothing,
+    compare_of,
+    compare_settings,
+    say_written,
+    scenario_from,
+)
+from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 
 
 def _cmd_run(args: argparse.Namespace) -> int:
-    from twin.envs.runner import run
+    from twin.envs.runner import run, run_many
     from twin.sim import report
 
-    result = run(scenario_from(args))
+    if args.compare and not args.html:
+        raise InvalidScenario("--compare records a second joint beside the first: use it with --html")
+    if args.compare:  # the second joint only for the recording; the metrics and outputs are the first's
+        compare = compare_of(args, args.compare)
+        first = scenario_from(args)
+        result, compared = run_many([first, compare.applied(first)])
+    else:
+        result, compared = run(scenario_from(args)), None
     outputs = [path for path in (args.trace, args.plot, args.html) if path is not None]
     with all_or_nothing(outputs) as temporary:  # every output, or none (a failed one leaves no other)
         staged = dict(zip(outputs, temporary, strict=True))
@@ -26,7 +41,8 @@ def _cmd_run(args: argparse.Namespace) -> int:
         if args.html:
             from viz.recording import write_recording
 
-            write_recording(result, staged[args.html])
+            write_recording(result, staged[args.html], compare=compared,
+                            compare_text=None if compared is None else args.compare)
     say_written(outputs)
     record = report.summary(result)
     if args.json:
@@ -48,4 +64,7 @@ def add_parser(sub) -> None:
     run.add_argument("--json", action="store_true", help="print exactly one JSON object")
     run.add_argument("--html", type=arguments.writable_file(".html"), metavar="FILE.html",
                      help="write a self-contained 3D recording with its traces")
+    run.add_argument("--compare", type=compare_settings, default=None, metavar="KEY=VALUE[,KEY=VALUE]",
+                     help="with --html: record a second joint beside the first, these scenario flags changed "
+                          "(as twin view --compare); the metrics printed are the first's")
     run.set_defaults(func=_cmd_run)

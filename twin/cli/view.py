@@ -7,21 +7,22 @@ import signal
 import sys
 import time
 
-from twin.cli.common import add_scenario_arguments, scenario_from
+from twin.cli.common import add_scenario_arguments, compare_of, compare_settings, scenario_from
 from twin.experiments import arguments
 
 
 def _cmd_view(args: argparse.Namespace) -> int:
     from viz.live_server import LiveSession, LiveViewer
 
-    session = LiveSession(scenario_from(args), record=args.html is not None)
+    compare = compare_of(args, args.compare) if args.compare else None
+    session = LiveSession(scenario_from(args), record=args.html is not None, compare=compare)
     viewer = LiveViewer(session, host=args.host, port=args.port, speed=args.speed)
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         print(f"warning: serving on {args.host}: anyone who can reach it can drive the twin", file=sys.stderr)
     print(f"twin view: open {viewer.url}  (Ctrl-C to stop)", flush=True)
     if args.duration is not None:
         stop_at = time.monotonic() + args.duration
-        viewer.on_frame = lambda: viewer.stop() if time.monotonic() >= stop_at else None
+        viewer.on_frame = lambda: viewer.shutdown() if time.monotonic() >= stop_at else None
     signal.signal(signal.SIGTERM, signal.default_int_handler)  # stop (and write --html) on SIGTERM too
     try:
         viewer.start()
@@ -47,6 +48,10 @@ def add_parser(sub) -> None:
     view.add_argument("--speed", type=arguments.speed, default=1.0, help="simulated seconds per second (default 1)")
     view.add_argument("--duration", type=arguments.seconds, default=None, metavar="SECONDS",
                       help="stop after this many seconds of wall time (default: run until Ctrl-C)")
+    view.add_argument("--compare", type=compare_settings, default=None, metavar="KEY=VALUE[,KEY=VALUE]",
+                      help="a second joint beside the first, with these scenario flags changed (controller, plant, "
+                           "payload, orientation, seed, noise=on|off, supply-kpa, without=EFFECT[+EFFECT]); "
+                           "same targets and replays")
     view.add_argument("--html", type=arguments.writable_file(".html"), metavar="FILE.html",
                       help="on stopping, write a recording of the last model's run (up to 10 min)")
     view.set_defaults(func=_cmd_view)

@@ -168,3 +168,58 @@ class LiveJoint:
             pressure_a=float(pa[0]), pressure_b=float(pb[0]),
             supply_pressure=float(self.plant.supply_now[0]),
             valve_open=tuple(bool(x) for x in self.plant.conductance[0] > 0))
+
+
+@dataclasses.dataclass(frozen=True)
+class Compare:
+    """What the second joint of compare mode changes from the first: ``Scenario`` fields (SI) and
+    the user's own ``KEY=VALUE`` text for display. Applied afresh to every first scenario, so a
+    controller, payload or orientation the page changes is shared unless this pins it."""
+
+    changes: dict  # Scenario field -> value, e.g. {"controller": "smc"}
+    text: dict  # the user's keys -> the user's values (edge units), e.g. {"controller": "smc"}
+
+    def applied(self, scenario: Scenario) -> Scenario:
+        return dataclasses.replace(scenario, **self.changes)
+
+
+class LiveJoints:
+    """The first :class:`LiveJoint` and, in compare mode, a second one; every command and every
+    tick goes to both, first then second, so they share targets, replays and time."""
+
+    def __init__(self, scenario: Scenario, compare: Compare | None = None):
+        self.compare = compare
+        self.joints = [LiveJoint(scenario)]
+        if compare is not None:
+            self.joints.append(LiveJoint(compare.applied(scenario)))
+
+    @property
+    def first(self) -> LiveJoint:
+        return self.joints[0]
+
+    @property
+    def second(self) -> LiveJoint | None:
+        return self.joints[1] if len(self.joints) > 1 else None
+
+    def set_target(self, angle: float) -> None:
+        for joint in self.joints:
+            joint.set_target(angle)
+
+    def play(self, number: int) -> None:
+        for joint in self.joints:
+            joint.play(number)
+
+    def switch_controller(self, name: str) -> None:
+        """The first joint's controller; the second's too unless compare mode pins its own."""
+        self.first.switch_controller(name)
+        if self.second is not None and "controller" not in self.compare.changes:
+            self.second.switch_controller(name)
+
+    def step(self) -> None:
+        for joint in self.joints:
+            joint.step()
+
+    def target(self) -> float:
+        """Where the current plan ends and holds (rad)."""
+        plan = self.first.plan
+        return plan.start + sum(seg.delta for seg in plan.segments)

@@ -1,0 +1,324 @@
+// Strip charts and the camera fit for the twin's pages (viz/live_page.html, viz/recording_page.html): a small canvas
+// drawer with no dependencies, so that the pages work offline and a recording stays one file.
+//
+// A trace is columns of samples, the field names of viz/live_server.py's samples and of
+// viz/recording.py's TraceRows.as_json():
+//   {time: [s], angle_deg, desired_deg, error_deg, duty (%), pressure_a_kpa, pressure_b_kpa,
+//    supply_kpa, valves: [[time, [V1, V2, V3, V4]], ...] (each change)}
+// Every chart draws every trace over the same time window [t0, t1]: the first joint in solid lines,
+// compare mode's second joint dashed and in a tint, with a legend.
+"use strict";
+
+const TWIN_CHARTS = [
+  {id: "angle", title: "angle", unit: "deg", series: [
+    {key: "angle_deg", label: "angle", color: "#c0392b"},
+    {key: "desired_deg", label: "desired", color: "#222222", dash: [2, 2]}]},
+  {id: "error", title: "error (desired - angle)", unit: "deg", symmetric: true, minSpan: 2, series: [
+    {key: "error_deg", label: "error", color: "#8e44ad"}]},
+  {id: "duty", title: "duty", unit: "%", symmetric: true, minSpan: 20, series: [
+    {key: "duty", label: "duty", color: "#2471a3"}]},
+  {id: "pressure", title: "pressure", unit: "kPa", fromZero: true, series: [
+    {key: "pressure_a_kpa", label: "chamber A", color: "#d35400"},
+    {key: "pressure_b_kpa", label: "chamber B", color: "#1e8449"},
+    {key: "supply_kpa", label: "supply", color: "#555555", dash: [1, 3]}]},
+  {id: "valves", title: "valves (open)", unit: "", kind: "valves"},
+];
+const TWIN_COMPARE_TINT = "#12a5b0";
+const TWIN_CAMERA_FOV = 35;  // deg, vertical field of view of the 3D view  // teal, as the second joint in the 3D view (viz/scene.py COMPARE_TINT)
+
+class StripCharts {
+  // container: an element to fill with one canvas per chart; labels: a name per trace (legend).
+  constructor(container, labels) {
+    this.container = container;
+    this.labels = labels;
+    this.charts = TWIN_CHARTS.map((spec) => {
+      const box = document.createElement("div");
+      box.className = "chart chart-" + spec.id;
+      const canvas = document.createElement("canvas");
+      canvas.dataset.chart = spec.id;
+      box.appendChild(canvas);
+      container.appendChild(box);
+      return {spec, canvas, layout: null};
+    });
+    this.draws = 0;
+    this.lastDraw = 0;
+  }
+
+  // Draw ``traces`` (one per joint) over [t0, t1] s, with a cursor at ``cursor`` s (or none).
+  draw(traces, t0, t1, cursor) {
+    for (const chart of this.charts) this._drawChart(chart, traces, t0, t1, cursor);
+    this.draws += 1;
+    this.lastDraw = performance.now();
+  }
+
+  // Where time t (s) falls across a chart's canvas, in CSS pixels from its left edge.
+  xOf(id, t) {
+    const chart = this.charts.find((c) => c.spec.id === id);
+    const L = chart.layout;
+    return L.left + (t - L.t0) / Math.max(L.t1 - L.t0, 1e-9) * L.width;
+  }
+
+  _size(canvas) {
+    const ratio = window.devicePixelRatio || 1;
+    const w = Math.max(50, canvas.clientWidth), h = Math.max(40, canvas.clientHeight);
+    if (canvas.width !== Math.round(w * ratio) || canvas.height !== Math.round(h * ratio)) {
+      canvas.width = Math.round(w * ratio);
+      canvas.height = Math.round(h * ratio);
+    }
+    const ctx = canvas.getContext("2d");
+    ctx.setTransform(ratio, 0, 0, ratio, 0, 0);
+    return [ctx, w, h];
+  }
+
+  _range(spec, traces, t0, t1) {
+    let lo = Infinity, hi = -Infinity;
+    for (const tr of traces) {
+      const time = tr.time;
+      for (const s of spec.series) {
+        const ys = tr[s.key];
+        if (!ys) continue;
+        for (let i = 0; i < time.length; i++) {
+          if (time[i] < t0 || time[i] > t1) continue;
+          const y = ys[i];
+          if (y < lo) lo = y;
+          if (y > hi) hi = y;
+        }
+      }
+    }
+    if (!isFinite(lo)) { lo = 0; hi = 1; }
+    if (spec.symmetric) { const m = Math.max(Math.abs(lo), Math.abs(hi), (spec.minSpan || 1) / 2); lo = -m; hi = m; }
+    if (spec.fromZero) lo = Math.min(0, lo);
+    const span = Math.max(hi - lo, spec.minSpan || 1);
+    const mid = (hi + lo) / 2;
+    lo = spec.fromZero ? lo : mid - span / 2;
+    hi = spec.fromZero ? lo + span : mid + span / 2;
+    const pad = 0.06 * (hi - lo);
+    return [spec.fromZero ? lo : lo - pad, hi + pad];
+  }
+
+  _ticks(lo, hi, count) {
+    const raw = (hi - lo) / count;
+    const power = Math.pow(10, Math.floor(Math.log10(raw)));
+    const step = [1, 2, 5, 10].map((m) => m * power).find((s) => s >= raw) || raw;
+    const ticks = [];
+    for (let v = Math.ceil(lo / step) * step; v <= hi + 1e-9; v += step) ticks.push(Math.abs(v) < 1e-9 ? 0 : v);
+    return ticks;
+  }
+
+  _drawChart(chart, traces, t0, t1, cursor) {
+    const {spec, canvas} = chart;
+    const [ctx, w, h] = this._size(canvas);
+    const left = 42, right = 6, top = 15, bottom = 16;
+    const width = w - left - right, height = h - top - bottom;
+    chart.layout = {left, top, width, height, t0, t1};
+    ctx.clearRect(0, 0, w, h);
+    ctx.fillStyle = "#ffffff";
+    ctx.fillRect(left, top, width, height);
+    ctx.font = "10px sans-serif";
+    ctx.fillStyle = "#222";
+    ctx.textBaseline = "alphabetic";
+    ctx.textAlign = "left";
+    ctx.fillText(spec.title + (spec.unit ? ` (${spec.unit})` : ""), left, 11);
+    const xOf = (t) => left + (t - t0) / Math.max(t1 - t0, 1e-9) * width;
+    // time axis: ticks in s
+    ctx.strokeStyle = "#e3e3e3";
+    ctx.lineWidth = 1;
+    ctx.textAlign = "center";
+    ctx.textBaseline = "top";
+    for (const t of this._ticks(t0, t1, Math.max(2, Math.floor(width / 60)))) {
+      const x = xOf(t);
+      ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, top + height); ctx.stroke();
+      ctx.fillStyle = "#444";
+      ctx.fillText(t.toFixed(Math.abs(t1 - t0) < 4 ? 1 : 0) + (x > left + width - 30 ? " s" : ""), x, top + height + 2);
+    }
+    if (spec.kind === "valves") {
+      this._drawValves(ctx, traces, t0, t1, xOf, left, top, width, height);
+    } else {
+      const [lo, hi] = this._range(spec, traces, t0, t1);
+      const yOf = (v) => top + height - (v - lo) / (hi - lo) * height;
+      ctx.textAlign = "right";
+      ctx.textBaseline = "middle";
+      for (const v of this._ticks(lo, hi, Math.max(2, Math.floor(height / 22)))) {
+        const y = yOf(v);
+        ctx.strokeStyle = "#e3e3e3";
+        ctx.beginPath(); ctx.moveTo(left, y); ctx.lineTo(left + width, y); ctx.stroke();
+        ctx.fillStyle = "#444";
+        ctx.fillText(String(Math.round(v * 100) / 100), left - 3, y);
+      }
+      ctx.save();
+      ctx.beginPath(); ctx.rect(left, top, width, height); ctx.clip();
+      traces.forEach((tr, j) => {
+        for (const s of spec.series) {
+          const ys = tr[s.key];
+          if (!ys) continue;
+          ctx.strokeStyle = j === 0 ? s.color : TWIN_COMPARE_TINT;
+          ctx.lineWidth = j === 0 ? 1.4 : 1.6;
+          ctx.setLineDash(j === 0 ? (s.dash || []) : (s.dash ? [1, 3] : [5, 3]));
+          ctx.beginPath();
+          let started = false;
+          const time = tr.time;
+          const step = Math.max(1, Math.floor(time.length / (2 * width)));  // at most ~2 points a pixel
+          for (let i = 0; i < time.length; i += step) {
+            if (time[i] < t0 - 0.05 || time[i] > t1 + 0.05) continue;
+            const x = xOf(time[i]), y = yOf(ys[i]);
+            if (started) ctx.lineTo(x, y); else { ctx.moveTo(x, y); started = true; }
+          }
+          ctx.stroke();
+        }
+      });
+      ctx.setLineDash([]);
+      ctx.restore();
+      this._legend(ctx, spec, traces.length, left + width, 11, left + ctx.measureText(spec.title + " (" + spec.unit + ")").width + 8);
+    }
+    ctx.strokeStyle = "#999";
+    ctx.lineWidth = 1;
+    ctx.strokeRect(left + 0.5, top + 0.5, width - 1, height - 1);
+    if (cursor !== null && cursor !== undefined) {
+      const x = xOf(cursor);
+      ctx.strokeStyle = "rgba(200, 0, 0, 0.85)";
+      ctx.lineWidth = 2;
+      ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, top + height); ctx.stroke();
+    }
+  }
+
+  _legend(ctx, spec, count, right, y, leftmost = 0) {
+    ctx.textAlign = "right";
+    ctx.textBaseline = "alphabetic";
+    let x = right;
+    const items = [];
+    for (const s of spec.series) items.push([s.label, s.color, s.dash || []]);
+    if (count > 1) items.push([this.labels[1] || "compare", TWIN_COMPARE_TINT, [5, 3]]);
+    for (const [label, color, dash] of items.reverse()) {
+      if (x - ctx.measureText(label).width - 20 < leftmost) break;  // no room: the title stays readable
+      ctx.fillStyle = "#333";
+      ctx.fillText(label, x, y);
+      x -= ctx.measureText(label).width + 3;
+      ctx.strokeStyle = color;
+      ctx.lineWidth = 1.6;
+      ctx.setLineDash(dash);
+      ctx.beginPath(); ctx.moveTo(x - 14, y - 3); ctx.lineTo(x, y - 3); ctx.stroke();
+      ctx.setLineDash([]);
+      x -= 20;
+    }
+  }
+
+  _drawValves(ctx, traces, t0, t1, xOf, left, top, width, height) {
+    const rows = 4, rowHeight = height / rows;
+    ctx.textAlign = "right";
+    ctx.textBaseline = "middle";
+    for (let v = 0; v < rows; v++) {
+      ctx.fillStyle = "#444";
+      ctx.fillText("V" + (v + 1), left - 3, top + (v + 0.5) * rowHeight);
+      if (v > 0) {
+        ctx.strokeStyle = "#e3e3e3";
+        ctx.beginPath(); ctx.moveTo(left, top + v * rowHeight); ctx.lineTo(left + width, top + v * rowHeight); ctx.stroke();
+      }
+    }
+    const share = traces.length;
+    traces.forEach((tr, j) => {
+      const changes = tr.valves || [];
+      ctx.fillStyle = j === 0 ? "#2ca02c" : TWIN_COMPARE_TINT;
+      for (let v = 0; v < rows; v++) {
+        const y = top + v * rowHeight + 2 + j * (rowHeight - 4) / share;
+        const hBar = (rowHeight - 4) / share;
+        for (let i = 0; i < changes.length; i++) {
+          if (!changes[i][1][v]) continue;
+          const start = changes[i][0];
+          const end = i + 1 < changes.length ? changes[i + 1][0] : (tr.time.length ? tr.time[tr.time.length - 1] : start);
+          if (end < t0 || start > t1) continue;
+          const x0 = Math.max(left, xOf(start)), x1 = Math.min(left + width, xOf(end));
+          ctx.fillRect(x0, y, Math.max(1, x1 - x0), hBar);
+        }
+      }
+    });
+    const legend = {spec: {series: [{label: "open", color: "#2ca02c"}]}};
+    this._legend(ctx, legend.spec, share, left + width, 11, left + 80);
+  }
+}
+
+// A trace that keeps only its last ``seconds`` (the live page's rolling window).
+class RollingTrace {
+  constructor(seconds) {
+    this.seconds = seconds;
+    this.data = RollingTrace.empty();
+  }
+  static empty() {
+    return {time: [], angle_deg: [], desired_deg: [], error_deg: [], duty: [], pressure_a_kpa: [],
+            pressure_b_kpa: [], supply_kpa: [], valves: []};
+  }
+  clear() { this.data = RollingTrace.empty(); }
+  push(samples) {
+    const d = this.data;
+    if (samples.time.length && d.time.length && samples.time[0] < d.time[d.time.length - 1]) this.clear();  // restarted
+    for (const key of Object.keys(d)) if (key !== "valves") for (const v of samples[key]) d[key].push(v);
+    for (const change of samples.valves) d.valves.push(change);
+    const latest = d.time.length ? d.time[d.time.length - 1] : 0;
+    let cut = 0;
+    while (cut < d.time.length && d.time[cut] < latest - this.seconds) cut++;
+    if (cut > 200) for (const key of Object.keys(d)) if (key !== "valves") d[key].splice(0, cut);
+    let vcut = 0;
+    while (vcut + 1 < d.valves.length && d.valves[vcut + 1][0] < latest - this.seconds) vcut++;
+    if (vcut > 50) d.valves.splice(0, vcut);
+  }
+}
+
+// The 3D view (meshcat's): the camera keeps its direction and moves in or out until every joint's view box fills the pane.
+function twinViewBoxes(viewer) {
+  const boxes = [];
+  viewer.scene.updateMatrixWorld(true);  // the scene may have changed since the last render
+  for (const root of ["twin", "compare"]) {
+    const node = viewer.scene_tree.children[root];
+    if (!node) continue;
+    const path = ["bodies", "housing", "view_box", "<object>"];
+    let n = node;
+    for (const name of path) { n = n && n.children[name]; }
+    if (!n || !n.object.children.length && !n.object.geometry) continue;
+    boxes.push(new MeshCat.THREE.Box3().setFromObject(n.object));
+  }
+  return boxes;
+}
+function fitCameraToViewBoxes(viewer) {
+  viewer.set_3d_pane_size();  // the camera's aspect from the pane as laid out now
+  const boxes = twinViewBoxes(viewer);
+  if (!boxes.length) return;
+  const camera = viewer.camera;
+  camera.fov = TWIN_CAMERA_FOV;  // narrower than meshcat's 75 deg: near and far parts drawn more alike
+  camera.updateProjectionMatrix();
+  const corners = [];
+  for (const b of boxes) for (const x of [b.min.x, b.max.x]) for (const y of [b.min.y, b.max.y]) for (const z of [b.min.z, b.max.z])
+    corners.push(new MeshCat.THREE.Vector3(x, y, z));
+  const target = viewer.controls.target;
+  const direction = camera.position.clone().sub(target).normalize();
+  const project = () => corners.map((c) => c.clone().project(camera));
+  const fits = (d) => {
+    camera.position.copy(target).addScaledVector(direction, d);
+    camera.lookAt(target);
+    camera.updateMatrixWorld(true);
+    return corners.every((c) => {
+      if (c.clone().applyMatrix4(camera.matrixWorldInverse).z > -camera.near) return false;  // behind the camera
+      const p = c.clone().project(camera);
+      return Math.abs(p.x) <= 0.96 && Math.abs(p.y) <= 0.96;
+    });
+  };
+  const fitDistance = () => {
+    let lo = 0.02, hi = 50;
+    for (let i = 0; i < 40; i++) { const mid = Math.sqrt(lo * hi); if (fits(mid)) hi = mid; else lo = mid; }
+    fits(hi);
+    return hi;
+  };
+  // Perspective draws the near side larger: pan (camera and target together) until the boxes sit
+  // in the middle of the view, then move in as far as they still fit.
+  for (let round = 0; round < 4; round++) {
+    const d = fitDistance();
+    const p = project();
+    const cx = (Math.min(...p.map((q) => q.x)) + Math.max(...p.map((q) => q.x))) / 2;
+    const cy = (Math.min(...p.map((q) => q.y)) + Math.max(...p.map((q) => q.y))) / 2;
+    const halfHeight = d * Math.tan(camera.fov * Math.PI / 360), halfWidth = halfHeight * camera.aspect;
+    const right = new MeshCat.THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 0);
+    const up = new MeshCat.THREE.Vector3().setFromMatrixColumn(camera.matrixWorld, 1);
+    target.addScaledVector(right, cx * halfWidth).addScaledVector(up, cy * halfHeight);
+  }
+  fitDistance();
+  viewer.controls.update();
+  viewer.set_dirty();
+}
