@@ -113,6 +113,19 @@ def over_ensemble(batch: Callable, cases: Sequence, *, seeds: Sequence[int], wor
     return [done[m] for m in range(count)]
 
 
+def run_cases(batch: Callable, cases: Sequence, *, seeds: Sequence[int], members: int | None = None,
+              workers: int = 2, bar=None) -> tuple[list[dict], int]:
+    """:func:`over_ensemble` with a progress ``bar`` (tqdm, optional) given the number of runs first and
+    counting them; also the number of members run."""
+    count = member_count() if members is None else members
+    per_member_runs = len(cases) * len(seeds)
+    if bar is not None:
+        bar.reset(total=count * per_member_runs)
+    per_member = over_ensemble(batch, cases, seeds=seeds, workers=workers, members=count,
+                               progress=None if bar is None else lambda: bar.update(per_member_runs))
+    return per_member, count
+
+
 def band(per_member: Sequence[dict], case, seeds: Sequence[int], field: str = "rmse_deg") -> dict:
     """The committed preset's value (member 0's seed mean) and the 10 / 90 % band of the members'
     seed means of ``field`` for ``case``."""

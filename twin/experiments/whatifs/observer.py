@@ -53,12 +53,8 @@ def observer_batch(plant, cases: tuple, seeds: tuple) -> dict:
 def observer_study(*, seeds: int = 3, members: int | None = None, workers: int = 2, bar=None) -> Outcome:
     cases = [(c, t, kind) for c in ("ffpva", "smc") for t in TRAJECTORIES for kind in OBSERVER_KINDS]
     seed_list = tuple(range(seeds))
-    count = ensemble.member_count() if members is None else members
-    if bar is not None:
-        bar.reset(total=count * len(cases) * seeds)
-    per_member = ensemble.over_ensemble(
-        observer_batch, cases, seeds=seed_list, workers=workers, members=count,
-        progress=None if bar is None else lambda: bar.update(len(cases) * seeds))
+    per_member, count = ensemble.run_cases(observer_batch, cases, seeds=seed_list, members=members, workers=workers,
+                                           bar=bar)
     rows = []
     for case in cases:
         tracking = ensemble.band(per_member, case, seed_list)

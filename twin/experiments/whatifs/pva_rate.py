@@ -72,12 +72,8 @@ def pva_rate_study(*, rates_ms: Sequence[int] = DEFAULT_RATES_MS, seeds: int = 2
     cells = ensemble.study_cells()
     cases = [(*cell, ms) for cell in cells for ms in rates_ms]
     seed_list = tuple(range(seeds))
-    count = ensemble.member_count() if members is None else members
-    if bar is not None:
-        bar.reset(total=count * len(cases) * seeds)
-    per_member = ensemble.over_ensemble(
-        rate_batch, cases, seeds=seed_list, workers=workers, members=count,
-        progress=None if bar is None else lambda: bar.update(len(cases) * seeds))
+    per_member, count = ensemble.run_cases(rate_batch, cases, seeds=seed_list, members=members, workers=workers,
+                                           bar=bar)
     rows = []
     for case in cases:
         b = ensemble.band(per_member, case, seed_list)
