@@ -177,8 +177,16 @@ def _stored(out: pathlib.Path, what: str = "COUNT(*)"):
         return [] if what == "key" else 0
 
 
+def _ctrl_c_as_in_a_terminal() -> None:
+    """In the child before exec: Ctrl-C at its default, as a user's terminal gives it. A shell that
+    starts this suite in the background without job control passes SIGINT on ignored, and Python then
+    never turns it into KeyboardInterrupt."""
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _start_and_wait_for_a_first_row(out: pathlib.Path, **popen) -> subprocess.Popen:
-    proc = subprocess.Popen(_sweep_argv(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, **popen)
+    proc = subprocess.Popen(_sweep_argv(out), stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                            preexec_fn=_ctrl_c_as_in_a_terminal, **popen)
     deadline = time.monotonic() + 120
     while _stored(out) == 0 and time.monotonic() < deadline and proc.poll() is None:
         time.sleep(0.05)
