@@ -9,14 +9,20 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-__all__ = ["finish", "plt"]
+__all__ = ["finish", "finish_panels", "plt"]
 
 
 def finish(fig, ax, path: pathlib.Path, *, xlabel: str, ylabel: str) -> None:
     """Label, grid and legend ``ax``, write ``fig`` to ``path`` and close it."""
     ax.set_xlabel(xlabel)
     ax.set_ylabel(ylabel)
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
+    finish_panels(fig, [ax], path)
+
+
+def finish_panels(fig, axes, path: pathlib.Path, *, legend_size: float = 8) -> None:
+    """Grid and legend every panel of ``axes``, write ``fig`` to ``path`` and close it."""
+    for ax in axes:
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=legend_size)
     fig.savefig(path, dpi=90)
     plt.close(fig)

@@ -102,6 +102,13 @@ def _row(r: Readout) -> tuple:
     return (r.time, r.angle, r.desired_angle, r.duty, r.pressure_a, r.pressure_b, r.supply_pressure)
 
 
+def _edge_units(r: Readout) -> dict[str, float]:
+    """A readout's numbers as the page shows them (degrees, %, kPa), named as :attr:`_Samples.FIELDS`."""
+    return {"time": r.time, "angle_deg": math.degrees(r.angle), "desired_deg": math.degrees(r.desired_angle),
+            "error_deg": math.degrees(r.error), "duty": r.duty, "pressure_a_kpa": r.pressure_a / 1e3,
+            "pressure_b_kpa": r.pressure_b / 1e3, "supply_kpa": r.supply_pressure / 1e3}
+
+
 class _Samples:
     """One joint's traces since the page's last frame, for its strip charts: every ``SAMPLE_TICKS``
     ticks a sample (degrees, %, kPa), and the valves' every change (tick exact: a 1 ms pulse shows)."""
@@ -115,10 +122,7 @@ class _Samples:
         self.last_open = b""
 
     def take(self, joint: LiveJoint) -> None:
-        r = joint.readout()
-        for name, value in zip(self.FIELDS, (r.time, math.degrees(r.angle), math.degrees(r.desired_angle),
-                                             math.degrees(r.error), r.duty, r.pressure_a / 1e3,
-                                             r.pressure_b / 1e3, r.supply_pressure / 1e3), strict=True):
+        for name, value in _edge_units(joint.readout()).items():
             self.columns[name].append(round(value, 4))
 
     def watch_valves(self, joint: LiveJoint) -> list | None:
@@ -181,14 +185,12 @@ class LiveSession:
 
     def frame(self) -> Frame:
         """Every joint's picture as one frame."""
-        transforms, colours = {}, {}
+        pictures = []
         for joint, scene in zip(self.joints.joints, self.scenes, strict=True):
             r = joint.readout()
-            one = scene.frame(joint.data, desired_angle=r.desired_angle, pressures=(r.pressure_a, r.pressure_b),
-                              valve_open=r.valve_open)
-            transforms.update(one.transforms)
-            colours.update(one.colours)
-        return Frame(transforms=transforms, colours=colours)
+            pictures.append(scene.frame(joint.data, desired_angle=r.desired_angle,
+                                        pressures=(r.pressure_a, r.pressure_b), valve_open=r.valve_open))
+        return Frame.merged(pictures)
 
     def _capture(self) -> None:
         if self.record:
@@ -197,11 +199,17 @@ class LiveSession:
                               None if second is None else _row(second.readout()))
 
     def _sample(self) -> None:
+        """Every joint's plotted sample now (after :meth:`_watch_valves`)."""
+        self._watch_valves()
+        for joint, samples in zip(self.joints.joints, self.samples, strict=True):
+            samples.take(joint)
+
+    def _watch_valves(self) -> None:
+        """Every joint's valve change at this tick, for the plots and the recording."""
         for i, (joint, samples) in enumerate(zip(self.joints.joints, self.samples, strict=True)):
             change = samples.watch_valves(joint)
             if change is not None and self.record:
                 self.recorder.valves[i].append(change)
-            samples.take(joint)
 
     def advance(self, duration: float) -> None:
         """Step ``duration`` seconds; the fraction of a tick left over is carried to the next call.
@@ -209,17 +217,13 @@ class LiveSession:
         self._debt += duration
         ticks = int(self._debt / self.joint.tick + 1e-9)
         self._debt -= ticks * self.joint.tick
-        pairs = list(zip(self.joints.joints, self.samples, strict=True))
         for _ in range(ticks):
             self.joints.step()
             steps = self.joint.steps
-            for i, (joint, samples) in enumerate(pairs):
-                change = samples.watch_valves(joint)
-                if change is not None and self.record:
-                    self.recorder.valves[i].append(change)
             if steps % self.sample_every == 0:
-                for joint, samples in pairs:
-                    samples.take(joint)
+                self._sample()
+            else:
+                self._watch_valves()
             if steps % self.record_every == 0:
                 self._capture()
         for joint in self.joints.joints:
@@ -258,10 +262,7 @@ class LiveSession:
         """The first joint's readout now (and the second's angle), with every joint's samples since
         the last call."""
         r = self.joint.readout()
-        message = {"type": "readout", "time": r.time, "angle_deg": math.degrees(r.angle),
-                   "desired_deg": math.degrees(r.desired_angle), "error_deg": math.degrees(r.error),
-                   "duty": r.duty, "pressure_a_kpa": r.pressure_a / 1e3, "pressure_b_kpa": r.pressure_b / 1e3,
-                   "supply_kpa": r.supply_pressure / 1e3, "valves": list(r.valve_open),
+        message = {"type": "readout", **_edge_units(r), "valves": list(r.valve_open),
                    "samples": [samples.drain() for samples in self.samples]}
         second = self.joints.second
         if second is not None:

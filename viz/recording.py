@@ -156,8 +156,7 @@ def write_recording(result: Result, path: pathlib.Path, *, compare: Result | Non
         scenes.append(scene)
         all_frames.append(frames)
         all_rows.append(rows)
-    frames = [Frame(transforms={**a.transforms, **b.transforms}, colours={**a.colours, **b.colours})
-              for a, b in zip(all_frames[0], all_frames[-1], strict=False)] if compare is not None else all_frames[0]
+    frames = [Frame.merged(pictures) for pictures in zip(*all_frames, strict=False)]
     title = f"{title_of(result.scenario)}: RMSE {np.degrees(result.metrics.rmse):.2f} deg"
     labels = ["first"]
     if compare is not None:

@@ -114,6 +114,12 @@ class Frame:
     transforms: dict[str, np.ndarray]
     colours: dict[str, tuple[float, float, float]]
 
+    @classmethod
+    def merged(cls, frames: Sequence[Frame]) -> Frame:
+        """One picture of several joints (each under its own root)."""
+        return cls(transforms={k: v for f in frames for k, v in f.transforms.items()},
+                   colours={k: v for f in frames for k, v in f.colours.items()})
+
 
 class JointScene:
     """The meshcat scene of one compiled joint under ``/root``; see the module docstring.

@@ -143,6 +143,15 @@ def test_t4_visits_150_30_90_30_degrees():
     assert _deg_at(4, [0.0])[0] == pytest.approx(30.0, abs=1e-9)
 
 
+@pytest.mark.parametrize("n, end_deg", [(1, 150.0), (2, 30.0 + 10e-3 / R_SPUR * 180 / math.pi), (3, 80.0),
+                                         (4, 30.0)])
+def test_trajectory_end_is_where_the_reference_holds(n, end_deg):
+    """``Trajectory.end`` (the live viewer's target after a replay): a ramp's end, a sine's where its
+    last period stops (80 deg after T3's two periods, not start + amplitude), by hand and as sampled."""
+    assert math.degrees(_traj(n).end) == pytest.approx(end_deg, abs=1e-9)
+    assert _deg_at(n, [_traj(n).duration + 1.0])[0] == pytest.approx(math.degrees(_traj(n).end), abs=1e-12)
+
+
 @pytest.mark.parametrize("n", [0, 5, 7, -1])
 def test_unknown_trajectory_is_rejected(n):
     with pytest.raises(InvalidScenario):

@@ -221,5 +221,4 @@ class LiveJoints:
 
     def target(self) -> float:
         """Where the current plan ends and holds (rad)."""
-        plan = self.first.plan
-        return plan.start + sum(seg.delta for seg in plan.segments)
+        return self.first.plan.end

@@ -24,6 +24,10 @@ THESIS_EXPERIMENT_SSE_T1_RANGE_DEG = {"pva": 0.41, "ffpva": 0.77, "smc": 0.85}
 # The robustness study's tip payloads (§9), g: none, then the thesis's two.
 THESIS_PAYLOADS_G = (0.0, *(round(m * 1e3, 9) for m in THESIS_PAYLOADS))
 
+# The robustness study's cells (Chapter 6, §9): (controller, trajectory, payload g, orientation), T1 and T3.
+ROBUSTNESS_CELLS = tuple((c, t, g, o) for c in ("ffpva", "smc") for t in (1, 3) for o in ("horizontal", "vertical")
+                         for g in THESIS_PAYLOADS_G)
+
 # The robustness study (Chapter 6, §9), measured, T1 only: (controller, orientation) -> payload g ->
 # (mean RMSE of 5 runs, std, SSE range +- max |SSE|). Every run lifted its payload and tracked (none
 # stalled). The T3 cells are held back for a blind prediction and are not in the twin.

@@ -37,7 +37,7 @@ import numpy as np
 from twin.batch.tables import write_csv
 from twin.experiments import calibrate
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.reference import THESIS_PAYLOADS_G, THESIS_SIMULATED_RMSE_DEG
+from twin.experiments.reference import ROBUSTNESS_CELLS, THESIS_SIMULATED_RMSE_DEG
 from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import plt
@@ -48,8 +48,7 @@ RMSE_TOLERANCE = 0.20
 SSE_TOLERANCE_DEG = 0.5
 DELAY_TOLERANCE = 1e-3  # s
 STALL_ERROR_DEG = 30.0  # a run whose error passes this did not follow the trajectory (stalled)
-PREDICTION_CELLS = tuple((c, 3, g, o) for c in ("ffpva", "smc") for o in ("horizontal", "vertical")
-                         for g in THESIS_PAYLOADS_G)
+PREDICTION_CELLS = tuple(cell for cell in ROBUSTNESS_CELLS if cell[1] == 3)  # the held-back T3 cells
 VALIDATION_COLUMNS = ("source", "controller", "trajectory", "payload_g", "orientation", "plant", "measured",
                       "twin_mean", "twin_std", "ratio", "within_tolerance")
 PREDICTION_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "twin_mean", "band_p10", "band_p50",

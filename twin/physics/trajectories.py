@@ -50,7 +50,14 @@ class Reference:
 class Segment:
     kind: str  # "cycloid" or "rest" or "ramp" or "sine"
     duration: float  # s
-    delta: float = 0.0  # rad of output angle (cycloid, ramp)
+    delta: float = 0.0  # rad of output angle (cycloid, ramp); the amplitude of a sine
+
+    @property
+    def change(self) -> float:
+        """rad the segment moves the angle from its start to its end (a sine: where its last period stops)."""
+        if self.kind == "sine":
+            return self.delta * math.sin(math.pi * self.duration)
+        return self.delta if self.kind in ("cycloid", "ramp") else 0.0
 
 
 @dataclasses.dataclass(frozen=True)
@@ -62,6 +69,14 @@ class Trajectory:
     @property
     def duration(self) -> float:
         return sum(s.duration for s in self.segments)  # s
+
+    @property
+    def end(self) -> float:
+        """rad, where the trajectory ends (and holds)."""
+        level = self.start
+        for seg in self.segments:
+            level = level + seg.change
+        return level
 
     @property
     def ends_at_rest(self) -> bool:
@@ -100,9 +115,7 @@ class Trajectory:
                 theta = np.where(inside, level + seg.delta * np.sin(w * local), theta)
                 omega = np.where(inside, seg.delta * w * np.cos(w * local), omega)
                 alpha = np.where(inside, -seg.delta * w * w * np.sin(w * local), alpha)
-            end_level = level + (seg.delta if seg.kind in ("cycloid", "ramp") else 0.0)
-            if seg.kind == "sine":
-                end_level = level + seg.delta * math.sin(math.pi * seg.duration)
+            end_level = level + seg.change
             theta = np.where(after, end_level, theta)
             omega = np.where(after, 0.0, omega)
             alpha = np.where(after, 0.0, alpha)

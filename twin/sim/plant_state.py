@@ -124,10 +124,10 @@ class PlantState:
                 self.pressure_a[group.idx] = group.chambers.state.pressure_a
                 self.pressure_b[group.idx] = group.chambers.state.pressure_b
         self._halls = [(g.idx, g.hall) for g in self._plant_groups if g.hall is not None]
-        self.observer = FirstOrderObserver(
-            gain=np.array([p.params.observer.gain for p in self.plants]), sample_period=tick,
-            initial=self._hall(start) + self.position_noise[:, 0])
-        self._kalman = _kalman_observers(self.plants, tick=tick, initial=self._hall(start) + self.position_noise[:, 0])
+        first_reading = self._hall(start) + self.position_noise[:, 0]
+        self.observer = FirstOrderObserver(gain=np.array([p.params.observer.gain for p in self.plants]),
+                                           sample_period=tick, initial=first_reading)
+        self._kalman = _kalman_observers(self.plants, tick=tick, initial=first_reading)
 
     def _hall(self, y: np.ndarray) -> np.ndarray:
         """The rack position the Hall sensor reports for the true ``y``, before noise."""

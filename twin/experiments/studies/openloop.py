@@ -24,7 +24,7 @@ from twin.experiments.base import Experiment, Outcome
 from twin.experiments.studies.robustness import default_plant
 from twin.physics.params import NOMINAL_PARAMS
 from twin.plants import plant
-from viz.figures import plt
+from viz.figures import finish_panels, plt
 
 OPENLOOP_AMPLITUDE = 45.0  # %
 OPENLOOP_SINE_PERIOD = 1.6  # s
@@ -206,11 +206,7 @@ def plot_openloop(study: OpenLoopStudy, path: pathlib.Path) -> None:
                   "dashed: soft limits; labels: lag", fontsize=9)
     bottom.set_ylabel("duty (%)")
     bottom.set_xlabel("time (s)")
-    for ax in (top, bottom):
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=8)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_panels(fig, (top, bottom), path)
 
 
 class OpenLoopExperiment(Experiment):

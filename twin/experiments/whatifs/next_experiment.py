@@ -39,8 +39,9 @@ import numpy as np
 import twin.experiments.whatifs.ensemble as ensemble
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
+from twin.experiments.reference import ROBUSTNESS_CELLS
 from twin.experiments.whatifs.common import progress_bar
-from viz.figures import plt
+from viz.figures import finish_panels, plt
 
 COLUMNS = ("experiment", "cell", "band_width_before_deg", "band_width_after_deg", "rig_hours")
 EXPERIMENTS = ("breakaway-map", "slow-sine")
@@ -155,10 +156,11 @@ def refit_widths(measurements: np.ndarray, predictions: np.ndarray) -> tuple[np.
     sigma = max(sigma, 1e-12)
     before = np.array([weighted_band(predictions[:, c], np.ones(members)) for c in range(predictions.shape[1])])
     after = np.zeros(predictions.shape[1])
+    overall = measurements.mean(axis=1)
     for t in range(members):
         for s in range(seeds):
             observed = measurements[t, s]
-            means = measurements.mean(axis=1)
+            means = overall.copy()
             means[t] = np.delete(measurements[t], s).mean()
             weights = np.exp(-0.5 * ((observed - means) / sigma) ** 2)
             after += [weighted_band(predictions[:, c], weights) for c in range(predictions.shape[1])]
@@ -179,9 +181,6 @@ def cell_label(cell: tuple) -> str:
 
 def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure_step: float = 10e3,
                           members: int | None = None, workers: int = 2, bar=None) -> Outcome:
-    from twin.experiments import calibrate
-    from twin.plants.as_built import ensemble_values
-
     count = ensemble.member_count() if members is None else members
     if count < 2:
         raise InvalidScenario("--members: the refit needs at least 2 ensemble members")
@@ -191,16 +190,10 @@ def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure
     step = (lambda: bar.update(1)) if bar is not None else None
     measured = ensemble.over_ensemble(experiment_batch, ((pressure_step,),), seeds=seed_list, workers=workers,
                                       members=count, progress=step)
-    evaluator = calibrate.Evaluator(seeds=range(prediction_seeds), workers=workers)
-    try:
-        predictions = []
-        for values in ensemble_values()[:count]:
-            predictions.append([cell.mean_rmse for cell in evaluator.cells(values, keys=ensemble.CHAPTER6_CELLS)])
-            if step:
-                step()
-    finally:
-        evaluator.close()
-    predictions = np.array(predictions)
+    predicted_seeds = tuple(range(prediction_seeds))
+    predicted = ensemble.over_ensemble(ensemble.cells_batch, ROBUSTNESS_CELLS, seeds=predicted_seeds,
+                                       workers=workers, members=count, progress=step)
+    predictions = np.array([ensemble.member_means(predicted, cell, predicted_seeds) for cell in ROBUSTNESS_CELLS]).T
     trials = float(np.mean([runs["breakaway-trials", s] for runs in measured for s in seed_list]))
     hours = rig_hours(trials)
     rows, summary = [], {}
@@ -209,7 +202,7 @@ def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure
         before, after, sigma = refit_widths(values, predictions)
         summary[name] = {"before": before, "after": after, "sigma": sigma, "values": values}
         rows += [dict(zip(COLUMNS, (name, cell_label(cell), float(b), float(a), hours[name]), strict=True))
-                 for cell, b, a in zip(ensemble.CHAPTER6_CELLS, before, after, strict=True)]
+                 for cell, b, a in zip(ROBUSTNESS_CELLS, before, after, strict=True)]
     answer = _answer(summary, hours, members=count, seeds=seeds, prediction_seeds=prediction_seeds,
                      pressure_step=pressure_step, trials=trials)
     return Outcome(rows, answer, detail=summary)
@@ -235,7 +228,7 @@ def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_
             f"{name}: measurement {member_means.min():.1f}-{member_means.max():.1f} {unit} across members, spread "
             f"within a member {s['sigma'] * scale:.1f} {unit}, so it tells the {len(order)} members apart in "
             f"{groups} groups; bands narrow to {kept:.0%} of their width in sum "
-            f"(widest cell {cell_label(ensemble.CHAPTER6_CELLS[widest])}: {before[widest]:.2f} -> "
+            f"(widest cell {cell_label(ROBUSTNESS_CELLS[widest])}: {before[widest]:.2f} -> "
             f"{after[widest]:.2f} deg); rig time {hours[name]:.1f} h; narrowing {score[name]:.2f} per hour.")
     best = max(score, key=score.get)
     lines.append(f"Answer: run the {best} experiment next: it narrows the predictions most per hour of rig time.")
@@ -251,7 +244,7 @@ def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_
 
 def plot_next_experiment(outcome: Outcome, path: pathlib.Path) -> None:
     summary = outcome.detail
-    cells = [cell_label(c) for c in ensemble.CHAPTER6_CELLS]
+    cells = [cell_label(c) for c in ROBUSTNESS_CELLS]
     fig, ax = plt.subplots(figsize=(12, 4.8), constrained_layout=True)
     x = np.arange(len(cells))
     first = summary[EXPERIMENTS[0]]["before"]
@@ -261,10 +254,7 @@ def plot_next_experiment(outcome: Outcome, path: pathlib.Path) -> None:
     ax.set_xticks(x, cells, rotation=70, ha="right", fontsize=7)
     ax.set_ylabel("width of the 10-90 % band (deg)")
     ax.set_title("Chapter 6 prediction bands before and after refitting on one more experiment", fontsize=9)
-    ax.grid(alpha=0.3, axis="y")
-    ax.legend(fontsize=8)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_panels(fig, [ax], path)
 
 
 class NextExperimentWhatIf(Experiment):

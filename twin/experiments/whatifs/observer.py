@@ -24,7 +24,7 @@ from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import progress_bar
 from twin.physics.params import OBSERVER_KINDS
 from twin.sim.scenario import CONTROLLER_LABELS
-from viz.figures import plt
+from viz.figures import finish_panels, plt
 
 COLUMNS = ("controller", "trajectory", "observer", "velocity_rms_error_mm_s", "rmse_mean_deg", "band_p10", "band_p90",
            "acceleration_rms_error_m_s2")
@@ -42,11 +42,11 @@ def with_observer(plant, kind: str):
 def observer_batch(plant, cases: tuple, seeds: tuple) -> dict:
     """Every (controller, trajectory, observer) case over ``seeds`` on ``plant``, one batch."""
     from twin.envs.runner import run_many
-    from twin.sim.scenario import Scenario
 
     variants = {kind: with_observer(plant, kind) for kind in OBSERVER_KINDS}
     jobs = [(case, s) for case in cases for s in seeds]
-    results = run_many([Scenario(c, t, plant=variants[kind], seed=s) for (c, t, kind), s in jobs], nthread=1)
+    results = run_many([ensemble.cell_scenario((c, t, 0.0, "horizontal"), variants[kind], s)
+                        for (c, t, kind), s in jobs], nthread=1)
     return {job: ensemble.summarise_run(r) for job, r in zip(jobs, results, strict=True)}
 
 
@@ -65,19 +65,26 @@ def observer_study(*, seeds: int = 3, members: int | None = None, workers: int =
     return Outcome(rows, answer(rows, members=count, seeds=seeds), failed=ensemble.failed_runs(per_member))
 
 
-def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
-    def row(c, t, kind):
-        return next(r for r in rows if (r["controller"], r["trajectory"], r["observer"]) == (c, t, kind))
+def _by_case(rows: Sequence[dict]) -> dict:
+    """{(controller, trajectory, observer): row}."""
+    return {(r["controller"], r["trajectory"], r["observer"]): r for r in rows}
 
+
+def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
+    from twin.physics.model import referred_mass
+    from twin.physics.params import NOMINAL_PARAMS
+
+    found = _by_case(rows)
     lines = [f"As-built plant, {members} calibration ensemble members x {seeds} seeds; errors against the twin's "
              "true rack state (committed preset), RMSE in deg as committed preset (ensemble 10-90 %). The Kalman "
              "filter runs on the thesis's bore and viscous friction and the train's mass referred to the rack "
-             "(43.5 g, not the thesis's lumped 32.9 g), with the Hall position and both chamber pressures; the "
+             f"({referred_mass() * 1e3:.1f} g, not the thesis's lumped {NOMINAL_PARAMS.masses.thesis_total_mass * 1e3:.1f} "
+             "g), with the Hall position and both chamber pressures; the "
              "controllers and their nominal model are unchanged."]
     ratios, accel_ratios, better = [], [], 0
     for c in ("ffpva", "smc"):
         for t in TRAJECTORIES:
-            first, kalman = row(c, t, "first-order"), row(c, t, "kalman")
+            first, kalman = found[c, t, "first-order"], found[c, t, "kalman"]
             ratios.append(kalman["velocity_rms_error_mm_s"] / first["velocity_rms_error_mm_s"])
             accel_ratios.append(kalman["acceleration_rms_error_m_s2"] / first["acceleration_rms_error_m_s2"])
             better += kalman["rmse_mean_deg"] < first["rmse_mean_deg"]
@@ -101,9 +108,9 @@ def plot_observer(rows: Sequence[dict], path: pathlib.Path) -> None:
     cases = [(c, t) for c in ("ffpva", "smc") for t in TRAJECTORIES]
     x = np.arange(len(cases))
     colours = {"first-order": "tab:grey", "kalman": "tab:green"}
+    by_case = _by_case(rows)
     for offset, kind in ((-0.2, "first-order"), (0.2, "kalman")):
-        found = [next(r for r in rows if (r["controller"], r["trajectory"], r["observer"]) == (c, t, kind))
-                 for c, t in cases]
+        found = [by_case[c, t, kind] for c, t in cases]
         left.bar(x + offset, [r["velocity_rms_error_mm_s"] for r in found], 0.4, color=colours[kind], label=kind)
         values = np.array([r["rmse_mean_deg"] for r in found])
         right.bar(x + offset, values, 0.4, color=colours[kind], label=f"{kind} (committed preset)")
@@ -113,12 +120,9 @@ def plot_observer(rows: Sequence[dict], path: pathlib.Path) -> None:
     for ax, ylabel in ((left, "velocity RMS error (mm/s)"), (right, "tracking RMSE (deg)")):
         ax.set_xticks(x, labels, fontsize=8)
         ax.set_ylabel(ylabel)
-        ax.grid(alpha=0.3, axis="y")
-        ax.legend(fontsize=8)
     left.set_title("observer error against the twin's true rack velocity", fontsize=9)
     right.set_title("tracking with each observer (as-built)", fontsize=9)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_panels(fig, (left, right), path)
 
 
 class ObserverWhatIf(Experiment):

@@ -23,7 +23,7 @@ from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import progress_bar
 from twin.sim.scenario import CONTROLLER_LABELS
-from viz.figures import plt
+from viz.figures import finish_panels, plt
 
 COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "update_ms", "rmse_mean_deg", "band_p10",
            "band_p90")
@@ -55,14 +55,11 @@ def controller_at(name: str, update_ms: int, plant):
 def rate_batch(plant, cases: tuple, seeds: tuple) -> dict:
     """Every (controller, trajectory, payload g, orientation, update ms) case over ``seeds`` on
     ``plant``, one batch; controllers of one name and rate shared (vectorised)."""
-    from twin.physics.model import Orientation
-    from twin.sim.scenario import Scenario
     from twin.sim.simulation import simulate
 
     controllers = {(c, ms): controller_at(c, ms, plant) for c, _, _, _, ms in cases}
     jobs = [(case, s) for case in cases for s in seeds]
-    scenarios = [Scenario(c, t, payload=g * 1e-3, orientation=Orientation(o), plant=plant, seed=s)
-                 for (c, t, g, o, _), s in jobs]
+    scenarios = [ensemble.cell_scenario(case[:4], plant, s) for case, s in jobs]
     results = simulate(scenarios, controllers=[controllers[case[0], case[4]] for case, _ in jobs], nthread=1)
     return {job: ensemble.summarise_run(r) for job, r in zip(jobs, results, strict=True)}
 
@@ -78,13 +75,12 @@ def pva_rate_study(*, rates_ms: Sequence[int] = DEFAULT_RATES_MS, seeds: int = 2
     for case in cases:
         b = ensemble.band(per_member, case, seed_list)
         rows.append(dict(zip(COLUMNS, (*case, b["value"], b["p10"], b["p90"]), strict=True)))
-    return Outcome(rows, answer(rows, members=count, seeds=seeds), failed=ensemble.failed_runs(per_member),
-                   detail={"members": count})
+    return Outcome(rows, answer(rows, members=count, seeds=seeds), failed=ensemble.failed_runs(per_member))
 
 
-def _row(rows: Sequence[dict], controller: str, cell: tuple, ms: int) -> dict:
-    return next(r for r in rows if (r["controller"], r["trajectory"], r["payload_g"], r["orientation"])
-                == (controller, *cell) and r["update_ms"] == ms)
+def _by_case(rows: Sequence[dict]) -> dict:
+    """{(controller, (trajectory, payload g, orientation), update ms): row}."""
+    return {(r["controller"], (r["trajectory"], r["payload_g"], r["orientation"]), r["update_ms"]): r for r in rows}
 
 
 def _fmt(r: dict) -> str:
@@ -96,20 +92,22 @@ def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
     rate does what sliding mode did at the thesis's rate."""
     rates = sorted({r["update_ms"] for r in rows})
     fast = rates[0]
+    row = _by_case(rows)
     cells = sorted({(r["trajectory"], r["payload_g"], r["orientation"]) for r in rows},
                    key=lambda c: (c[2], c[1], c[0]))
     lines = [f"As-built plant, {members} calibration ensemble members x {seeds} seeds per case; RMSE in deg as "
              f"committed preset (ensemble 10-90 %). FF + PVA (and sliding mode's FF + PVA part) updated every "
              f"{', '.join(f'{r:g}' for r in rates)} ms; the valves keep the 16 ms PWM."]
     for controller in ("ffpva", "smc"):
-        gains = [(_row(rows, controller, c, THESIS_UPDATE_MS)["rmse_mean_deg"]
-                  - _row(rows, controller, c, fast)["rmse_mean_deg"]) for c in cells]
+        gains = [(row[controller, c, THESIS_UPDATE_MS]["rmse_mean_deg"]
+                  - row[controller, c, fast]["rmse_mean_deg"]) for c in cells]
         better = sum(g > 0 for g in gains)
         lines.append(f"{CONTROLLER_LABELS[controller]}: at {fast:g} ms instead of 16 ms, RMSE is lower in "
                      f"{better} of {len(cells)} cells (median change {-np.median(gains):+.2f} deg).")
-    best_ffpva = {c: min((_row(rows, "ffpva", c, ms) for ms in rates), key=lambda r: r["rmse_mean_deg"])
+    best_ffpva = {c: min((row["ffpva", c, ms] for ms in rates), key=lambda r: r["rmse_mean_deg"])
                   for c in cells}
-    smc_thesis = {c: _row(rows, "smc", c, THESIS_UPDATE_MS) for c in cells}
+    smc_thesis = {c: row["smc", c, THESIS_UPDATE_MS] for c in cells}
+    ffpva_thesis = {c: row["ffpva", c, THESIS_UPDATE_MS] for c in cells}
     wins = [c for c in cells if best_ffpva[c]["rmse_mean_deg"] <= smc_thesis[c]["rmse_mean_deg"]]
     clear = [c for c in wins if best_ffpva[c]["band_p90"] < smc_thesis[c]["band_p10"]]
     lines.append(f"Would a faster PVA have made sliding mode unnecessary? FF + PVA at its best rate matches or "
@@ -118,13 +116,13 @@ def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
     for c in cells:
         label = f"T{c[0]} {c[1]:g} g {c[2]}"
         lines.append(f"  {label}: FF + PVA best {best_ffpva[c]['update_ms']:g} ms {_fmt(best_ffpva[c])}, "
-                     f"16 ms {_fmt(_row(rows, 'ffpva', c, THESIS_UPDATE_MS))}; sliding mode 16 ms "
-                     f"{_fmt(smc_thesis[c])}, {fast:g} ms {_fmt(_row(rows, 'smc', c, fast))}")
-    already = [c for c in cells if _row(rows, "ffpva", c, THESIS_UPDATE_MS)["rmse_mean_deg"]
+                     f"16 ms {_fmt(ffpva_thesis[c])}; sliding mode 16 ms "
+                     f"{_fmt(smc_thesis[c])}, {fast:g} ms {_fmt(row['smc', c, fast])}")
+    already = [c for c in cells if ffpva_thesis[c]["rmse_mean_deg"]
                <= smc_thesis[c]["rmse_mean_deg"]]
-    faster = np.median([_row(rows, "ffpva", c, THESIS_UPDATE_MS)["rmse_mean_deg"] - best_ffpva[c]["rmse_mean_deg"]
+    faster = np.median([ffpva_thesis[c]["rmse_mean_deg"] - best_ffpva[c]["rmse_mean_deg"]
                         for c in cells])
-    sliding = np.median([_row(rows, "ffpva", c, THESIS_UPDATE_MS)["rmse_mean_deg"] - smc_thesis[c]["rmse_mean_deg"]
+    sliding = np.median([ffpva_thesis[c]["rmse_mean_deg"] - smc_thesis[c]["rmse_mean_deg"]
                          for c in cells])
     verdict = ("yes, as far as the twin shows: in most cells" if len(wins) > len(cells) / 2
                else "no, as far as the twin shows: in most cells it does not")
@@ -157,28 +155,24 @@ def plot_pva_rate(rows: Sequence[dict], path: pathlib.Path) -> None:
     left.set_xlabel("FF + PVA update period (ms)")
     left.set_ylabel("RMSE (deg)")
     left.set_title("T1-T4, horizontal, no payload (band: ensemble 10-90 %)", fontsize=9)
-    left.grid(alpha=0.3)
-    left.legend(fontsize=7, ncol=2)
     fast = min(r["update_ms"] for r in rows)
+    row = _by_case(rows)
     for controller in ("ffpva", "smc"):
         slow = [r for r in rows if r["controller"] == controller and r["update_ms"] == THESIS_UPDATE_MS]
-        quick = [_row(rows, controller, (r["trajectory"], r["payload_g"], r["orientation"]), fast) for r in slow]
+        quick = [row[controller, (r["trajectory"], r["payload_g"], r["orientation"]), fast] for r in slow]
         for a, b in zip(slow, quick, strict=True):  # the bands as crossing segments (the value may lie outside)
             right.plot([a["band_p10"], a["band_p90"]], [b["rmse_mean_deg"]] * 2, color=colours[controller], lw=0.8)
             right.plot([a["rmse_mean_deg"]] * 2, [b["band_p10"], b["band_p90"]], color=colours[controller], lw=0.8)
         right.plot([r["rmse_mean_deg"] for r in slow], [r["rmse_mean_deg"] for r in quick], "o",
                    color=colours[controller], label=CONTROLLER_LABELS[controller])
-    top = max(max(r["band_p90"] for r in rows), 1.0) * 1.05
+    top = max(max(r["band_p90"] for r in rows), max(r["rmse_mean_deg"] for r in rows), 1.0) * 1.05
     right.plot([0, top], [0, top], color="0.5", ls=":", label="no change")
     right.set_xlim(0, top)
     right.set_ylim(0, top)
     right.set_xlabel("RMSE, FF + PVA every 16 ms (deg)")
     right.set_ylabel(f"RMSE, FF + PVA every {fast:g} ms (deg)")
     right.set_title("every cell (T1-T4, Chapter 6 payloads and orientations)", fontsize=9)
-    right.grid(alpha=0.3)
-    right.legend(fontsize=8)
-    fig.savefig(path, dpi=90)
-    plt.close(fig)
+    finish_panels(fig, (left, right), path, legend_size=7)
 
 
 class PvaRateWhatIf(Experiment):
