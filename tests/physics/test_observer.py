@@ -8,6 +8,7 @@ import numpy as np
 import pytest
 
 from twin.exceptions import InvalidParameter
+from twin.physics.model import referred_mass
 from twin.physics.params import NOMINAL_PARAMS, ObserverParams
 from twin.physics.sensing import KalmanObserver
 
@@ -16,7 +17,7 @@ T = 1e-3  # s
 
 def observer(density: float = ObserverParams().disturbance_density) -> KalmanObserver:
     p = NOMINAL_PARAMS
-    return KalmanObserver(mass=p.masses.thesis_total_mass, area=p.cylinder.bore_area, viscous=p.friction.viscous,
+    return KalmanObserver(mass=referred_mass(p), area=p.cylinder.bore_area, viscous=p.friction.viscous,
                           disturbance_density=density, position_noise=p.sensors.position_noise,
                           pressure_noise=p.sensors.pressure_noise, sample_period=T, initial=np.zeros(2))
 
@@ -54,7 +55,8 @@ def test_kalman_reads_the_velocity_a_pressure_difference_drives():
     closed-form velocity u/c (1 - e^{-ct}) and acceleration u e^{-ct}."""
     p = NOMINAL_PARAMS
     obs = observer()
-    mass, c = p.masses.thesis_total_mass, p.friction.viscous / p.masses.thesis_total_mass
+    mass = referred_mass(p)  # as the plant's filter (twin.sim.plant_state)
+    c = p.friction.viscous / mass
     dp = np.array([50e3, -20e3])  # Pa, P_a - P_b
     u = p.cylinder.bore_area * dp / mass
     obs.update(np.zeros(2), dp, np.zeros(2))  # tick 0: at rest, the pressures applied from here on
