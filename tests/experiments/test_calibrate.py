@@ -91,12 +91,14 @@ def test_targets_are_section_8_and_the_chapter_6_t1_cells_each_once_and_no_t3():
     assert cost(exact_cells({("smc", 1, 13.5, "vertical"): 2.0})) == pytest.approx(cauchy(math.log(2.0)))
 
 
-def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_the_breakaway_extremes():
+def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_each_profiled_extreme():
     E = calibrate.Evaluation
 
-    def v(f, a=0.01):
-        return {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14}
+    def v(f, a=0.01, load=0.2):
+        return {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14,
+                "load_friction": load}
 
+    assert calibrate.PROFILED == ("load_friction", "stiction")
     history = [E(v(2.0), 1.00, "scan"), E(v(1.2), 1.04, "profile"), E(v(2.4), 1.05, "profile"),
                E(v(1.8), 1.02, "simplex"), E(v(1.8), 1.02, "simplex"), E(v(2.5), 1.30, "profile"),
                E(v(1.9, 0.02), 1.01, "simplex")]
@@ -104,6 +106,12 @@ def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_the_break
     assert [e.values["stiction"] for e in chosen] == [2.0, 1.2, 2.4, 1.9, 1.8]  # 2.5 N costs more than the noise
     assert [e.values["stiction"] for e in calibrate.choose_ensemble(history, history[0], 0.06, limit=3)] == [2.0, 1.2, 2.4]
     assert calibrate.choose_ensemble(history, history[0], noise=0.0) == [history[0]]
+    # the load friction's extremes come before the breakaway's; one costing more than the noise never
+    loads = history + [E(v(1.8, load=0.1), 1.03, "profile"), E(v(1.8, load=0.5), 1.05, "profile"),
+                       E(v(1.8, load=0.6), 1.20, "profile")]
+    chosen = calibrate.choose_ensemble(loads, loads[0], 0.06, limit=4)
+    assert [(e.values["load_friction"], e.values["stiction"]) for e in chosen] == [(0.2, 2.0), (0.1, 1.8), (0.5, 1.8),
+                                                                                   (0.2, 1.2)]
 
 
 def test_a_failed_run_costs():
@@ -144,8 +152,8 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
 def test_unit_box_maps_onto_the_plausible_bounds():
     assert values_at([0.0] * len(FITTED)) == {f.name: f.low for f in FITTED}
     assert values_at([1.0] * len(FITTED)) == {f.name: f.high for f in FITTED}
-    assert values_at([2.0, -1.0, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
-    assert calibrate.unit_of(values_at([0.25, 0.5, 0.75, 1.0])) == pytest.approx((0.25, 0.5, 0.75, 1.0))
+    assert values_at([2.0, -1.0, 0.5, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
+    assert calibrate.unit_of(values_at([0.25, 0.5, 0.75, 1.0, 0.1])) == pytest.approx((0.25, 0.5, 0.75, 1.0, 0.1))
 
 
 def test_the_breakaway_bound_is_what_245_kpa_could_start_from_rest():
@@ -220,7 +228,8 @@ def test_same_seeds_same_fit_whatever_the_workers():
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex", "profile", "profile"]
+    # two points along each profiled parameter (the load friction, then the breakaway)
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 4
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)

@@ -91,7 +91,8 @@ def _fake(ratio_13_5: float, lag_within: bool, stalled: int) -> validate.Validat
                     120.0 if lag_within else 70.0, None, lag_within))
     prediction = [{"controller": "smc", "trajectory": 3, "payload_g": 13.5, "orientation": "vertical",
                    "twin_mean": 2.9, "band_p10": 2.8, "band_p50": 2.9, "band_p90": 3.1, "stalled_runs": stalled}]
-    detail = {"members": [{"stiction": 1.0}, {"stiction": 2.2}], "runs": 10, "per_member": [[2.8], [3.1]]}
+    detail = {"members": [{"stiction": 1.0, "load_friction": 0.15}, {"stiction": 2.2, "load_friction": 0.45}],
+              "runs": 10, "per_member": [[2.8], [3.1]]}
     return validate.Validation(rows=rows, prediction=prediction, prediction_detail=detail,
                                failed=0, stalled={("smc", 1, 13.5, "vertical"): 0})
 
@@ -103,8 +104,10 @@ def test_report_says_plainly_what_misses_and_what_the_runs_show():
     assert "T2: measured sliding mode < FF + PVA < PVA + DZC, twin FF + PVA < PVA + DZC < sliding mode" in text
     assert "T1: measured" not in text  # right there
     assert "does **not** lag the model" in text and "tracks it better than the real joint did" in text
-    assert "spans 1.00-2.20 N" in text and "no run of any member stalls" in text
-    assert "does not turn on it" in text  # a 0.3 deg band
+    assert "spans 1.00-2.20 N of breakaway and 0.15-0.45 N/N of load friction" in text
+    assert "no run of any member stalls" in text
+    assert "does not turn on them" in text  # a 0.3 deg band
+    assert "their load friction (N/N): 0.15, 0.45." in text
     other = validate.report(_fake(1.0, lag_within=True, stalled=3))
     assert "lags the model, as the real joint did" in other and "Within tolerance." in other
     assert "some members' runs stall" in other

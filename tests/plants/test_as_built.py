@@ -2,7 +2,8 @@
 
 Chambers (§3): pressure build-up through one valve, the hydraulic natural
 frequency of two sealed chambers. Friction (§4): breakaway at the mapped
-stiction, direction-dependent Coulomb friction, the held supply valve's creep. Supply line (§3): step
+stiction, direction-dependent Coulomb friction, the load friction (breakaway at
+limit / (1 - mu), steady speed at (|F| (1 - mu) - F_c) / damping), the held supply valve's creep. Supply line (§3): step
 recovery and steady sag of the L-R-C line, the accumulator's slower recovery.
 Then the whole plant: a 200-sub-step reference, all effects off is the thesis
 plant exactly, every effect's switch is wired, and the Hall reading in the loop.
@@ -24,6 +25,7 @@ from twin.exceptions import InvalidScenario
 from twin.physics import hydraulics
 from twin.physics.chambers import CompressibleCircuit
 from twin.physics.hall import HallReading
+from twin.physics.model import Orientation
 from twin.physics.params import ChamberParams, FrictionParams, StictionMapParams, SupplyLineParams, ValveParams
 from twin.physics.stiction_map import StictionMap
 from twin.plants import PLANTS
@@ -41,7 +43,7 @@ FRICTIONLESS = FrictionParams(viscous=0.0, coulomb_poly=(0.0,), stiction=0.0)
 CONSTANT_SUPPLY = SupplyLineParams()  # the thesis's P_s = P_0
 THESIS_FRICTION = FrictionParams(stiction=0.0)  # eq. 4.5.5 with eq. 4.5.7
 VALUES = {"stiction": 1.5, "air_fraction": 0.01, "ccw_coulomb_scale": 1.1,
-          "leak_conductance": 1e-14}
+          "leak_conductance": 1e-14, "load_friction": 0.3}
 
 
 def eq_4_5_7(y: float) -> float:
@@ -308,6 +310,11 @@ def test_accumulator_recovers_at_the_lower_natural_frequency():
 Y_FIXED = 8.0e-3  # m: F_c = 1.80 N (eq. 4.5.7)
 SCALE = 1.4
 CCW_FRICTION = FrictionParams(stiction=0.0, ccw_coulomb_scale=SCALE)
+LOAD = 0.3  # N of friction per N of load the train carries
+LOADED_FRICTION = dataclasses.replace(CCW_FRICTION, load_friction=LOAD)
+# (friction, the share of the external force that drives): the external force is the load the train carries,
+# so the load friction takes LOAD |F| from it
+STEADY_CASES = [(CCW_FRICTION, 1.0), (LOADED_FRICTION, 1.0 - LOAD)]
 
 
 def steady_velocity_closed_form(force: float) -> float:
@@ -318,29 +325,56 @@ def steady_velocity_closed_form(force: float) -> float:
 
 
 @pytest.mark.parametrize("force", [4.0, -4.0])
-def test_steady_velocity_with_direction_dependent_coulomb_incompressible(force):
+@pytest.mark.parametrize(("params", "drive"), STEADY_CASES)
+def test_steady_velocity_with_direction_dependent_coulomb_incompressible(force, params, drive):
     tank = hydraulics.circuit(conductances(g2=G_OPEN, g4=G_OPEN), np.array([300e3]), AREA)
     v, stuck = np.zeros(1), np.ones(1, dtype=bool)
     for _ in range(100):  # M / c = 0.9 ms
-        out = hydraulics.rack_step(circuit_now=tank, friction_params=CCW_FRICTION, bore_area=AREA,
+        out = hydraulics.rack_step(circuit_now=tank, friction_params=params, bore_area=AREA,
                                    y=np.array([Y_FIXED]), v0=v, external_force=np.array([force]), stuck=stuck,
                                    mass=np.array([MASS]), h=H)
         v, stuck = out.velocity, out.stuck
-    assert v[0] == pytest.approx(steady_velocity_closed_form(force), rel=1e-6)
+    assert v[0] == pytest.approx(steady_velocity_closed_form(drive * force), rel=1e-6)
 
 
 @pytest.mark.parametrize("force", [4.0, -4.0])
-def test_steady_velocity_with_direction_dependent_coulomb_compressible(force):
+@pytest.mark.parametrize(("params", "drive"), STEADY_CASES)
+def test_steady_velocity_with_direction_dependent_coulomb_compressible(force, params, drive):
     """Same closed form: at steady flow P_a = -A v / g_2, P_b = A v / g_4 (a few kPa, above cavitation)."""
-    circuit = make_circuit(friction_params=CCW_FRICTION)
+    circuit = make_circuit(friction_params=params)
     v, stuck = np.zeros(1), np.ones(1, dtype=bool)
     for _ in range(100):
         out = circuit.tick(conductance=conductances(g2=G_OPEN, g4=G_OPEN), y=np.array([Y_FIXED]), v0=v,
                            external_force=np.array([force]), stuck=stuck, mass=np.array([MASS]), h=H,
                            breakaway=constant(0.0))
         v, stuck = out.velocity, out.stuck
-    assert v[0] == pytest.approx(steady_velocity_closed_form(force), rel=1e-6)
+    assert v[0] == pytest.approx(steady_velocity_closed_form(drive * force), rel=1e-6)
     assert circuit.state.pressure_a[0] == pytest.approx(-AREA * v[0] / G_OPEN, rel=1e-6)
+
+
+@pytest.mark.parametrize("direction", [1.0, -1.0])
+def test_load_friction_raises_the_breakaway_to_limit_over_one_minus_mu(direction):
+    """A load F held by the map's breakaway plus mu |F| starts to move at F = limit / (1 - mu)."""
+    limit = float(MAP(np.array([Y_BETWEEN_KNOTS]))[0])
+    loaded = dataclasses.replace(THESIS_FRICTION, load_friction=LOAD)
+    tank = hydraulics.circuit(conductances(g2=G_OPEN, g4=G_OPEN), np.array([300e3]), AREA)
+    circuit = make_circuit(friction_params=loaded)
+    for plant_step in ("incompressible", "compressible"):
+        y, v, stuck = np.array([Y_BETWEEN_KNOTS]), np.zeros(1), np.ones(1, dtype=bool)
+        for k in range(1, 4001):
+            force = np.array([direction * limit * k / 2000])
+            if plant_step == "incompressible":
+                out = hydraulics.rack_step(circuit_now=tank, friction_params=loaded, bore_area=AREA, y=y, v0=v,
+                                           external_force=force, stuck=stuck, mass=np.array([MASS]), h=H,
+                                           breakaway=MAP(y))
+            else:
+                out = circuit.tick(conductance=conductances(g2=G_OPEN, g4=G_OPEN), y=y, v0=v, external_force=force,
+                                   stuck=stuck, mass=np.array([MASS]), h=H, breakaway=MAP)
+            v, stuck = out.velocity, out.stuck
+            if not stuck[0]:
+                break
+        assert not stuck[0] and np.sign(v[0]) == direction
+        assert abs(force[0]) == pytest.approx(limit / (1 - LOAD), rel=0.01), plant_step
 
 
 # --------------------------------------------------------------------------- 6. held supply valve creep
@@ -477,12 +511,23 @@ def test_all_effects_off_is_the_thesis_plant(controller, thesis_t4):
     assert same(ours, thesis)
 
 
-@pytest.mark.parametrize("effect", [e for e in EFFECTS if e != "supply_line"])
+@pytest.mark.parametrize("effect", [e for e in EFFECTS if e not in ("supply_line", "load_friction")])
 def test_each_effect_alone_changes_the_run(effect, thesis_t4):
     alone = as_built_plant(VALUES, without=[e for e in EFFECTS if e != effect])
     result = run(Scenario("ffpva", 4, plant=alone, seed=1))
     assert not result.warnings
     assert not same(result, thesis_t4("ffpva")), f"{effect} alone changes nothing"
+
+
+def test_load_friction_alone_changes_only_a_loaded_run(thesis_t4):
+    """Horizontal, gravity is along the shaft and the train carries no load: the thesis plant's run
+    exactly. Vertical with 13.5 g, the load friction slows the lift: a larger error."""
+    alone = as_built_plant(VALUES, without=[e for e in EFFECTS if e != "load_friction"])
+    assert same(run(Scenario("ffpva", 4, plant=alone, seed=1)), thesis_t4("ffpva"))
+    loaded = {"payload": 13.5e-3, "orientation": Orientation.VERTICAL, "seed": 1}
+    with_load, thesis = (run(Scenario("ffpva", 1, plant=p, **loaded)) for p in (alone, "thesis"))
+    assert not with_load.warnings
+    assert with_load.metrics.rmse > 1.1 * thesis.metrics.rmse
 
 
 def test_the_supply_line_changes_the_compressible_run():

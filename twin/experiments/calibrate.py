@@ -29,12 +29,13 @@ Search, deterministic (the same code and seeds give the same file):
 2. Nelder-Mead from the best of them, at most :data:`SIMPLEX_EVALUATIONS` evaluations;
 3. the seed-to-seed noise of the best cost: the best values so far on :data:`NOISE_SEED_SETS`
    (each as many seeds as the fit, disjoint), noise = the sample std of those costs and the fit's;
-4. a profile of the breakaway (the parameter the vertical predictions turn on): the best values
-   with the breakaway at :data:`PROFILE_POINTS` points across its box; the fitted values are then
-   the lowest cost of all evaluations (a profile point may beat the simplex);
+4. profiles of the two parameters the vertical predictions turn on (:data:`PROFILED`): the best
+   values with the load friction at :data:`PROFILE_POINTS` points across its box, then the best of
+   all so far with the breakaway likewise; the fitted values are then the lowest cost of all
+   evaluations (a profile point may beat the simplex);
 5. the ensemble: every evaluated parameter set whose cost is within the noise of the best
    (cost <= best + noise), at most :data:`ENSEMBLE_MAX` of them (the best first, then the
-   lowest and highest breakaway, then by cost).
+   lowest and highest of each profiled parameter, then by cost).
 """
 
 from __future__ import annotations
@@ -66,13 +67,14 @@ LOSS_SCALE = math.log(1.2)  # the Cauchy loss's scale: the tolerance, "within 20
 FIT_SEEDS = tuple(range(10))  # noise seeds every evaluation sees (two five-run groups per cell)
 CHECK_SEEDS = (0, 1, 2, 3, 4)  # the thesis's five runs, for the residual table (cut from the fit's runs)
 NOISE_SEED_SETS = (tuple(range(10, 20)), tuple(range(20, 30)), tuple(range(30, 40)))  # for the cost's noise
-SCAN_POINTS = 8  # Sobol points (a power of two)
+SCAN_POINTS = 16  # Sobol points (a power of two)
 SCAN_SEED = 0
-SIMPLEX_EVALUATIONS = 14
-PROFILE_POINTS = 5
+SIMPLEX_EVALUATIONS = 24
+PROFILE_POINTS = 5  # per profiled parameter
+PROFILED = ("load_friction", "stiction")  # in this order; the vertical payload cells turn on both
 ENSEMBLE_MAX = 8
-MAX_EVALUATIONS = SCAN_POINTS + 1 + SIMPLEX_EVALUATIONS + PROFILE_POINTS  # on the fit seeds; + the noise sets
-FILE_VERSION = 4  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise
+MAX_EVALUATIONS = SCAN_POINTS + 1 + SIMPLEX_EVALUATIONS + PROFILE_POINTS * len(PROFILED)  # + the noise sets
+FILE_VERSION = 5  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction
 
 
 @dataclasses.dataclass(frozen=True)
@@ -282,15 +284,19 @@ def cost_noise(costs: Sequence[float]) -> float:
 def choose_ensemble(evaluations: Sequence[Evaluation], best: Evaluation, noise: float,
                     limit: int = ENSEMBLE_MAX) -> list[Evaluation]:
     """The evaluations within ``noise`` of the best cost (duplicates once), at most ``limit``: the best
-    first, then those with the lowest and the highest breakaway (so the band shows what the
-    breakaway does), then the rest by cost."""
+    first, then those with the lowest and the highest value of each :data:`PROFILED` parameter (so the
+    band shows what each does), then the rest by cost."""
     unique: dict[tuple, Evaluation] = {}
     for e in evaluations:
         unique.setdefault(tuple(sorted(e.values.items())), e)
     near = sorted((e for e in unique.values() if e.cost <= best.cost + noise), key=lambda e: e.cost)
     chosen = [best]
-    by_breakaway = sorted(near, key=lambda e: e.values["stiction"])
-    for e in [*(by_breakaway[:1] + by_breakaway[-1:]), *near]:
+    extremes = []
+    for name in PROFILED:
+        ordered = sorted(near, key=lambda e: e.values[name])
+        if ordered[0].values[name] < ordered[-1].values[name]:  # a parameter the near sets share tells nothing
+            extremes += [ordered[0], ordered[-1]]
+    for e in [*extremes, *near]:
         if len(chosen) >= limit:
             break
         if all(e.values != c.values for c in chosen):
@@ -312,7 +318,7 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
     from scipy.stats import qmc
 
     started = time.perf_counter()
-    planned = scan_points + 1 + simplex_evaluations + profile_points + len(noise_seed_sets)
+    planned = scan_points + 1 + simplex_evaluations + profile_points * len(PROFILED) + len(noise_seed_sets)
     history: list[Evaluation] = []
     seen: dict[tuple[float, ...], tuple[Evaluation, list[CellResult]]] = {}
     evaluator = Evaluator(seeds=fit_seeds, workers=workers)
@@ -362,9 +368,10 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
             noise_costs.append(cost(evaluator.cells(seen[best_key][0].values, seeds=seeds)))
             report(noise_costs[-1], seen[best_key][0].values)
         stage = "profile"
-        index = [f.name for f in FITTED].index("stiction")
-        for x in np.linspace(0.0, 1.0, profile_points) if profile_points else []:
-            objective([x if i == index else best_key[i] for i in range(len(FITTED))])
+        for name in PROFILED:  # each about the best of all so far (the first profile may move it)
+            index, centre = [f.name for f in FITTED].index(name), lowest()
+            for x in np.linspace(0.0, 1.0, profile_points) if profile_points else []:
+                objective([x if i == index else centre[i] for i in range(len(FITTED))])
         # A profile point may beat the simplex (the cost is flat along the breakaway, within the noise):
         # the fitted values are the lowest cost evaluated.
         best, fit_cells = seen[lowest()]
@@ -401,7 +408,8 @@ def record(result: Calibration) -> dict:
     return {
         "version": FILE_VERSION,
         "code_version": code_version(),
-        "made_by": f"twin calibrate (Sobol scan of {SCAN_POINTS} + centre, Nelder-Mead, breakaway profile; "
+        "made_by": f"twin calibrate (Sobol scan of {SCAN_POINTS} + centre, Nelder-Mead, profiles of "
+                   f"{' and '.join(PROFILED)}; "
                    f"{result.evaluations} evaluations on fit seeds {list(result.fit_seeds)})",
         "loss": f"Cauchy, scale ln 1.2 = {LOSS_SCALE:.4f}; SSE-range residuals weighted sqrt({SSE_WEIGHT})",
         "targets": [dataclasses.asdict(t) for t in TARGETS],

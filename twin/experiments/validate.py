@@ -249,14 +249,16 @@ def _why(v: Validation) -> list[str]:
                      "The twin's chambers build pressure faster than the real ones did.")
     members = v.prediction_detail["members"]
     low, high = min(m["stiction"] for m in members), max(m["stiction"] for m in members)
+    load_low, load_high = min(m["load_friction"] for m in members), max(m["load_friction"] for m in members)
     spread_t3 = max(r["band_p90"] - r["band_p10"] for r in v.prediction)
     widest = max(v.prediction, key=lambda r: (r["band_p90"] - r["band_p10"]) / r["band_p50"])
     relative = (widest["band_p90"] - widest["band_p10"]) / widest["band_p50"]
-    lines.append(f"- **The breakaway**: the ensemble spans {low:.2f}-{high:.2f} N of breakaway, fitting the "
+    lines.append(f"- **The breakaway and the load friction**: the ensemble spans {low:.2f}-{high:.2f} N of "
+                 f"breakaway and {load_low:.2f}-{load_high:.2f} N/N of load friction, fitting the "
                  f"measurements about equally well; the widest T3 band is {spread_t3:.2f} deg ("
                  f"{CONTROLLER_LABELS[widest['controller']]} {widest['payload_g']:g} g {widest['orientation']}: "
                  f"{relative:.0%} of its median), so within what the data allow the T3 prediction "
-                 + ("does not turn on it" if relative < RMSE_TOLERANCE else "**turns on it**: read the band, not "
+                 + ("does not turn on them" if relative < RMSE_TOLERANCE else "**turns on them**: read the band, not "
                     "the committed value")
                  + (" (no run of any member stalls)." if not any(r["stalled_runs"] for r in v.prediction) else
                     "; some members' runs stall, counted per cell above."))
@@ -337,7 +339,8 @@ def report(v: Validation) -> str:
               f"{len(d['members'])} members of the calibration ensemble (five runs each). The band is the 10-90 % "
               "range of the members' five-run means; `stalled` counts the members' runs whose error passed "
               f"{STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). Breakaway of the members (N): "
-              + ", ".join(f"{m['stiction']:.2f}" for m in d["members"]) + ".", "",
+              + ", ".join(f"{m['stiction']:.2f}" for m in d["members"]) + "; their load friction (N/N): "
+              + ", ".join(f"{m['load_friction']:.2f}" for m in d["members"]) + ".", "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | stalled |", "|---|---|---|---|---|---|---|---|"]
     for r in v.prediction:
         lines.append(f"| {CONTROLLER_LABELS[r['controller']]} | {r['payload_g']:g} g | {r['orientation']} | "

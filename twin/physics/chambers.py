@@ -98,17 +98,19 @@ class CompressibleCircuit:
         ``breakaway(y)`` the static friction (N) at rack positions y.
 
         Chamber volumes, Coulomb friction and breakaway are taken at the tick's start
-        position (the rack moves at most 0.15 mm in a tick: 0.5 % of a chamber)."""
+        position (the rack moves at most 0.15 mm in a tick: 0.5 % of a chamber); both carry the load
+        friction of ``external_force`` (:func:`twin.physics.friction.load_friction`)."""
         s, ch, fp = self.state, self.chambers, self.friction
         va, vb = self.volumes(y)
-        forward, backward = friction.coulomb_both_ways(fp, y)
+        forward, backward = friction.coulomb_both_ways(fp, y, external_force)
+        static = np.asarray(breakaway(y), dtype=float) + friction.load_friction(fp, external_force)
         line = self._line if self._line is not None else (1.0, 1.0, 0.0)
         out = np.empty((4, len(y)))
         _substeps(
             s.pressure_a, s.pressure_b, s.supply_pressure, s.line_flow, np.ascontiguousarray(conductance, dtype=float),
             va, vb, np.asarray(y, dtype=float), self.stroke[0], self.stroke[1],
             forward, backward,
-            np.asarray(breakaway(y), dtype=float), np.asarray(v0, dtype=float), np.asarray(stuck, dtype=np.bool_),
+            static, np.asarray(v0, dtype=float), np.asarray(stuck, dtype=np.bool_),
             np.asarray(mass, dtype=float), np.asarray(external_force, dtype=float), self.source,
             self.area, fp.viscous, h / ch.substeps, ch.substeps, ch.leak_conductance,
             ch.air_fraction * ch.atmospheric_pressure, 1.0 / ch.water_bulk_modulus, ch.atmospheric_pressure,

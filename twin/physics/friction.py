@@ -6,6 +6,10 @@
 *Resolution* (SPEC §4): the fit is sane only on y = 2 - 14.5 mm, so ``y`` is
 clamped to that range and ``F_c`` to >= 0. The direction-dependent variant
 scales ``F_c`` by ``ccw_coulomb_scale`` when moving towards 0 deg (v < 0).
+
+The plants add, to the Coulomb force and to the breakaway alike, a dry friction that grows with the load
+the gear train carries (``load_friction`` |F_ext|, :func:`load_friction`): the thesis's friction tests
+carried no load beyond the train's own, so eq. 4.5.7 holds none of it.
 """
 
 from __future__ import annotations
@@ -48,11 +52,20 @@ def coulomb_force(params: FrictionParams, y: np.ndarray, direction: np.ndarray) 
     return out
 
 
-def coulomb_both_ways(params: FrictionParams, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """F_c(y) moving towards +y and towards 0 deg, for the steps that decide the direction inside their
-    compiled loops; each the same numbers as :func:`coulomb_force` in that direction."""
+def coulomb_both_ways(params: FrictionParams, y: np.ndarray, load: np.ndarray | float = 0.0
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """F_c(y) moving towards +y and towards 0 deg, each plus the load friction of ``load`` (N, the external
+    force on the train along y), for the steps that decide the direction inside their compiled loops;
+    without load each the same numbers as :func:`coulomb_force` in that direction."""
     forward = coulomb_force(params, y, np.ones(np.shape(y)))
-    return forward, forward * params.ccw_coulomb_scale
+    extra = load_friction(params, load)
+    return forward + extra, forward * params.ccw_coulomb_scale + extra
+
+
+def load_friction(params: FrictionParams, load: np.ndarray | float) -> np.ndarray:
+    """The dry friction (N, >= 0) that carrying ``load`` (N along the rack: gravity through the gears)
+    adds to the train's, in either direction and at rest: ``params.load_friction`` |load|."""
+    return params.load_friction * np.abs(np.asarray(load, dtype=float))
 
 
 def force_loss(params: FrictionParams, y: np.ndarray, v: np.ndarray) -> np.ndarray:

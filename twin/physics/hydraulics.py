@@ -177,15 +177,17 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
     is the train's inertia referred to the rack; ``breakaway`` (N) the static
     friction at ``y`` if it varies along the stroke (default: the constant
     ``friction_params.stiction``). Coulomb friction is eq. 4.5.7 as
-    :func:`twin.physics.friction.coulomb_force` gives it, in the direction it acts.
+    :func:`twin.physics.friction.coulomb_force` gives it, in the direction it acts; the load friction of
+    ``external_force`` (:func:`twin.physics.friction.load_friction`) adds to it and to the breakaway.
     """
     n = len(y)
 
     def each(x, dtype=float):  # (n,) contiguous: the compiled loop reads x[i] unchecked
         return per_scenario(x, n, dtype)
 
-    static = friction_params.stiction if breakaway is None else breakaway
-    forward, backward = (each(f) for f in friction.coulomb_both_ways(friction_params, y))  # eq. 4.5.7
+    static = (friction_params.stiction if breakaway is None else breakaway) + friction.load_friction(
+        friction_params, external_force)
+    forward, backward = (each(f) for f in friction.coulomb_both_ways(friction_params, y, external_force))
     out, stuck_out = np.empty((6, n)), np.empty(n, dtype=np.bool_)
     _rack_steps(circuit_now.conductances, circuit_now.supply_pressure, float(bore_area),
                 float(friction_params.viscous), forward, backward, each(v0), each(external_force),

@@ -189,9 +189,14 @@ class FrictionParams:
     fit_range: tuple[float, float] = (2e-3, 14.5e-3)  # m, where eq. 4.5.7 was fitted (*resolution*: clamp)
     stiction: float = 3.6  # N, average static friction (§4)
     ccw_coulomb_scale: float = 1.0  # F_c multiplier moving towards 0 deg (direction-dependent variant)
+    # N of dry friction per N of load the gear train carries besides its own (gravity through the gears,
+    # referred to the rack): the meshes', the rack guides' and the bushings' friction grows with the load
+    # they transmit. The §4.5.1 friction tests (eq. 4.5.7) ran horizontal without payload, so none of it
+    # is in F_c. The thesis plant has none (0); the as-built plant fits it (twin.plants.as_built.FITTED).
+    load_friction: float = 0.0
 
     def __post_init__(self) -> None:
-        if self.viscous < 0 or self.stiction < 0 or self.ccw_coulomb_scale < 0:
+        if self.viscous < 0 or self.stiction < 0 or self.ccw_coulomb_scale < 0 or self.load_friction < 0:
             raise InvalidParameter("friction coefficients must be non-negative")
         if not self.fit_range[0] < self.fit_range[1]:
             raise InvalidParameter(f"fit_range must be increasing, got {self.fit_range}")
