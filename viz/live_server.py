@@ -90,7 +90,7 @@ class _Recorder:
 
     def trace_rows(self, *, compare: bool = False) -> TraceRows:
         rows = self.compare_rows if compare else self.rows
-        columns = np.array([row[:7] for row in rows], dtype=float).reshape(-1, 7).T
+        columns = np.array(rows, dtype=float).reshape(-1, 7).T  # each row holds the seven columns
         time_, angle, desired, duty, pa, pb, supply = columns
         start = time_[0] if len(time_) else 0.0
         changes = [[max(t - start, 0.0), is_open] for t, is_open in self.valves[1 if compare else 0]]
@@ -267,8 +267,7 @@ class LiveSession:
         second = self.joints.second
         if second is not None:
             c = second.readout()
-            message.update(compare_angle_deg=math.degrees(c.angle), compare_error_deg=math.degrees(c.error),
-                           compare_duty=c.duty)
+            message.update(compare_angle_deg=math.degrees(c.angle), compare_duty=c.duty)
         return message
 
     def state(self) -> dict:
@@ -358,8 +357,7 @@ class _SocketHandler(tornado.websocket.WebSocketHandler):
         self.viewer.clients.add(self)
         if not self.viewer.greeted:  # the first page sees the joint move: replay T1 for it
             self.viewer.greeted = True
-            self.viewer.session.play(REPLAY_ON_CONNECT)
-            self.viewer.broadcast([json.dumps(self.viewer.session.state())])
+            self.viewer.session.play(REPLAY_ON_CONNECT)  # its state goes with the setup below
         for message in [*_packed(self.viewer.session.setup_commands()), json.dumps(self.viewer.session.state())]:
             _send(self, message)
 

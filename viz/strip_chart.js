@@ -41,14 +41,12 @@ class StripCharts {
       return {spec, canvas, layout: null};
     });
     this.draws = 0;
-    this.lastDraw = 0;
   }
 
   // Draw ``traces`` (one per joint) over [t0, t1] s, with a cursor at ``cursor`` s (or none).
   draw(traces, t0, t1, cursor) {
     for (const chart of this.charts) this._drawChart(chart, traces, t0, t1, cursor);
     this.draws += 1;
-    this.lastDraw = performance.now();
   }
 
   // Where time t (s) falls across a chart's canvas, in CSS pixels from its left edge.

@@ -4,6 +4,7 @@ PWM study's controller rates, the gear-load windows and the CLI."""
 from __future__ import annotations
 
 import csv
+import dataclasses
 import math
 import os
 import pathlib
@@ -33,15 +34,26 @@ def test_lewis_safe_loads_of_spec_section_2(spur, speed, expected):
     assert float(lewis_safe_load(GearParams(), spur=spur, pitch_line_speed=speed)) == pytest.approx(expected, abs=0.02)
 
 
-def _lift_by_hand(pressure: float) -> float:
-    """Torque balance at the worst angle of 80-100 deg, eq. 4.5.7 written out here (thesis plant: no stiction)."""
+def _lift_by_hand(pressure: float, load_friction: float = 0.0) -> float:
+    """Torque balance at the worst angle of 80-100 deg, eq. 4.5.7 written out here (thesis plant: no
+    stiction); a load friction mu makes the gears' gravity load cost (1 + mu) times itself."""
     p = JointParams()
     r_s, length, area = 9.525e-3 / 2, 35e-3, math.pi * 2e-3**2
     theta = np.radians(np.linspace(80, 100, 2001))
     y = np.clip(theta * r_s, 2e-3, 14.5e-3)
     coulomb = np.maximum(np.polyval(COULOMB, y), 0.0)
-    mass = (pressure * area - coulomb) * r_s / (9.81 * length * np.sin(theta)) - p.masses.link_mass / 2
+    carried = (1 + load_friction) * 9.81 * length * np.sin(theta)
+    mass = (pressure * area - coulomb) * r_s / carried - p.masses.link_mass / 2
     return float(mass.min())
+
+
+def test_static_lift_limit_pays_the_load_friction():
+    from twin.experiments.whatifs.lift import lift_limit_closed_form
+
+    loaded = dataclasses.replace(JointParams(), friction=dataclasses.replace(JointParams().friction, stiction=0.0,
+                                                                              load_friction=0.3))
+    assert lift_limit_closed_form(loaded, 400e3) == pytest.approx(_lift_by_hand(400e3, 0.3), rel=1e-3)
+    assert lift_limit_closed_form(loaded, 400e3) < 0.8 * _lift_by_hand(400e3)
 
 
 @pytest.mark.slow  # over ~2.5 s on 2 cores

@@ -141,6 +141,13 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
         for chunk in chunks:
             on_done(run_chunk(chunk))
         return
+    run_forked([(run_chunk, (chunk,)) for chunk in chunks], workers, on_done)
+
+
+def run_forked(calls: Sequence[tuple[Callable, tuple]], workers: int, on_done: Callable) -> None:
+    """Each ``function(*arguments)`` of ``calls`` (module-level functions) on ``workers`` forked processes,
+    ``on_done(result)`` in the parent as each finishes. The kernels are compiled once before the fork;
+    on Ctrl-C, SIGTERM or an error the queued calls are cancelled and the workers killed, not waited for."""
     import twin.envs.runner  # noqa: F401 - imported and compiled once here, inherited by every forked worker
     from twin.sim.plant_state import compile_kernels
 
@@ -149,12 +156,12 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
     pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                                   initializer=worker_setup)
     try:
-        futures = [pool.submit(run_chunk, chunk) for chunk in chunks]
+        futures = [pool.submit(function, *arguments) for function, arguments in calls]
         for future in concurrent.futures.as_completed(futures):
             on_done(future.result())
     except BaseException:
-        # Ctrl-C, SIGTERM or an error: what finished is already stored; the chunks in flight are lost
-        # (at most one per worker), and the workers are stopped now rather than waited for.
+        # Ctrl-C, SIGTERM or an error: what finished has been handed to on_done; the calls in flight are
+        # lost (at most one per worker), and the workers are stopped now rather than waited for.
         processes = list((getattr(pool, "_processes", None) or {}).values())
         pool.shutdown(wait=False, cancel_futures=True)
         for process in processes:

@@ -73,7 +73,6 @@ SIMPLEX_EVALUATIONS = 24
 PROFILE_POINTS = 5  # per profiled parameter
 PROFILED = ("load_friction", "stiction")  # in this order; the vertical payload cells turn on both
 ENSEMBLE_MAX = 8
-MAX_EVALUATIONS = SCAN_POINTS + 1 + SIMPLEX_EVALUATIONS + PROFILE_POINTS * len(PROFILED)  # + the noise sets
 FILE_VERSION = 5  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction
 
 
@@ -370,7 +369,7 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
         stage = "profile"
         for name in PROFILED:  # each about the best of all so far (the first profile may move it)
             index, centre = [f.name for f in FITTED].index(name), lowest()
-            for x in np.linspace(0.0, 1.0, profile_points) if profile_points else []:
+            for x in np.linspace(0.0, 1.0, profile_points):
                 objective([x if i == index else centre[i] for i in range(len(FITTED))])
         # A profile point may beat the simplex (the cost is flat along the breakaway, within the noise):
         # the fitted values are the lowest cost evaluated.

@@ -102,8 +102,7 @@ class CompressibleCircuit:
         friction of ``external_force`` (:func:`twin.physics.friction.load_friction`)."""
         s, ch, fp = self.state, self.chambers, self.friction
         va, vb = self.volumes(y)
-        forward, backward = friction.coulomb_both_ways(fp, y, external_force)
-        static = np.asarray(breakaway(y), dtype=float) + friction.load_friction(fp, external_force)
+        forward, backward, static = friction.dry_limits(fp, y, external_force, np.asarray(breakaway(y), dtype=float))
         line = self._line if self._line is not None else (1.0, 1.0, 0.0)
         out = np.empty((4, len(y)))
         _substeps(

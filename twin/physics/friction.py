@@ -52,20 +52,27 @@ def coulomb_force(params: FrictionParams, y: np.ndarray, direction: np.ndarray) 
     return out
 
 
-def coulomb_both_ways(params: FrictionParams, y: np.ndarray, load: np.ndarray | float = 0.0
-                      ) -> tuple[np.ndarray, np.ndarray]:
-    """F_c(y) moving towards +y and towards 0 deg, each plus the load friction of ``load`` (N, the external
-    force on the train along y), for the steps that decide the direction inside their compiled loops;
-    without load each the same numbers as :func:`coulomb_force` in that direction."""
+def coulomb_both_ways(params: FrictionParams, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """F_c(y) moving towards +y and towards 0 deg, for the steps that decide the direction inside their
+    compiled loops; each the same numbers as :func:`coulomb_force` in that direction."""
     forward = coulomb_force(params, y, np.ones(np.shape(y)))
-    extra = load_friction(params, load)
-    return forward + extra, forward * params.ccw_coulomb_scale + extra
+    return forward, forward * params.ccw_coulomb_scale
 
 
 def load_friction(params: FrictionParams, load: np.ndarray | float) -> np.ndarray:
     """The dry friction (N, >= 0) that carrying ``load`` (N along the rack: gravity through the gears)
     adds to the train's, in either direction and at rest: ``params.load_friction`` |load|."""
     return params.load_friction * np.abs(np.asarray(load, dtype=float))
+
+
+def dry_limits(params: FrictionParams, y: np.ndarray, load: np.ndarray | float, static: np.ndarray | float
+               ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The dry friction a step may apply at rack positions ``y`` carrying ``load`` (N, the external force
+    along y): Coulomb moving towards +y, Coulomb towards 0 deg, and the breakaway ``static`` (N) at rest,
+    each plus the load friction (computed once)."""
+    forward, backward = coulomb_both_ways(params, y)
+    extra = load_friction(params, load)
+    return forward + extra, backward + extra, static + extra
 
 
 def force_loss(params: FrictionParams, y: np.ndarray, v: np.ndarray) -> np.ndarray:

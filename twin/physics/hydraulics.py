@@ -185,12 +185,11 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
     def each(x, dtype=float):  # (n,) contiguous: the compiled loop reads x[i] unchecked
         return per_scenario(x, n, dtype)
 
-    static = (friction_params.stiction if breakaway is None else breakaway) + friction.load_friction(
-        friction_params, external_force)
-    forward, backward = (each(f) for f in friction.coulomb_both_ways(friction_params, y, external_force))
+    forward, backward, static = (each(f) for f in friction.dry_limits(  # eq. 4.5.7 and the load friction
+        friction_params, y, external_force, friction_params.stiction if breakaway is None else breakaway))
     out, stuck_out = np.empty((6, n)), np.empty(n, dtype=np.bool_)
     _rack_steps(circuit_now.conductances, circuit_now.supply_pressure, float(bore_area),
                 float(friction_params.viscous), forward, backward, each(v0), each(external_force),
-                each(stuck, np.bool_), each(mass), float(h), each(static), out, stuck_out)
+                each(stuck, np.bool_), each(mass), float(h), static, out, stuck_out)
     return RackForces(cylinder_a=out[0], cylinder_b=out[1], pressure_a=out[2], pressure_b=out[3],
                       velocity=out[4], force_loss=out[5], stuck=stuck_out)

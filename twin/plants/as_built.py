@@ -69,7 +69,6 @@ STICTION_SCATTER = 0.5  # N, the stiction map's scatter about the fitted breakaw
 BREAKAWAY_TEST_PRESSURE = 245e3  # Pa: §4.5.1 started the joint from rest at 245 kPa, pair at 100 %, both ways
 # The highest fitted breakaway that lets every point of the map break away at 245 kPa: P A - scatter (2.58 N).
 BREAKAWAY_BOUND = BREAKAWAY_TEST_PRESSURE * THESIS_PARAMS.cylinder.bore_area - STICTION_SCATTER
-LOAD_FRICTION_BOUND = 0.6  # N/N: dry brass on brass along the whole load path (FITTED's load_friction)
 
 FITTED = (
     Fitted("stiction", 1.0, BREAKAWAY_BOUND, "N", "breakaway force about which the map scatters. Top: §4.5.1 "
@@ -84,7 +83,7 @@ FITTED = (
     Fitted("leak_conductance", 0.0, 3e-14, "m^3/(Pa s)", "past each discharge valve to the tank: from a tight "
            "seat to 0.54 mL/min at 300 kPa (a 0.05 mL drop every 6 s: a visibly weeping seat, more than a "
            "valve sold as normally closed would be let go with)"),
-    Fitted("load_friction", 0.0, LOAD_FRICTION_BOUND, "N/N", "dry friction per N of gravity load the gear train "
+    Fitted("load_friction", 0.0, 0.6, "N/N", "dry friction per N of gravity load the gear train "
            "carries (referred to the rack), added to Coulomb and breakaway alike; the §4.5.1 tests that gave "
            "eq. 4.5.7 ran horizontal without payload, so it is in no thesis number. Bottom: a frictionless train. "
            "Top: dry brass on brass (mu 0.3) everywhere the load passes: the rack-pinion and pinion-spur meshes "
@@ -186,6 +185,5 @@ def ensemble_plants(path: pathlib.Path = CALIBRATION_FILE) -> list:
     return [as_built_plant(values, name=f"as-built~{k}") for k, values in enumerate(ensemble_values(path))]
 
 
-__all__ = ["ASSUMED", "BREAKAWAY_BOUND", "CALIBRATION_FILE", "EFFECTS", "FITTED", "LOAD_FRICTION_BOUND",
-           "STICTION_SCATTER",
+__all__ = ["ASSUMED", "BREAKAWAY_BOUND", "CALIBRATION_FILE", "EFFECTS", "FITTED", "STICTION_SCATTER",
            "as_built_params", "as_built_plant", "calibrated_values", "ensemble_plants", "ensemble_values"]

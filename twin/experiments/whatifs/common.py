@@ -30,6 +30,16 @@ def list_flag(args: argparse.Namespace, flag: str, attribute: str, axis: str) ->
     return values
 
 
+def batch_progress(bar, count: int):
+    """``simulate``'s ``progress(done_ticks, total_ticks)`` for one batch of ``count`` scenarios, shown on
+    ``bar`` (tqdm, or None: no progress) in scenarios from where it stands (the batch's scenarios advance
+    together)."""
+    if bar is None:
+        return None
+    start = bar.n
+    return lambda done, ticks: bar.update(start + count * done // ticks - bar.n)
+
+
 @contextlib.contextmanager
 def progress_bar(name: str):
     """A scenario-counting progress bar on stderr, labelled ``name``."""

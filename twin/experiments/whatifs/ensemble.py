@@ -10,10 +10,8 @@ that comes from what the measurements could not pin down, not from the sensor no
 
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
 import math
-import multiprocessing
 from collections.abc import Callable, Sequence
 
 import numpy as np
@@ -114,16 +112,14 @@ def over_ensemble(batch: Callable, cases: Sequence, *, seeds: Sequence[int], wor
             if progress:
                 progress()
     else:
-        from twin.batch.sweep import worker_setup  # workers die with their parent
+        from twin.batch.sweep import run_forked  # workers die with their parent, and on Ctrl-C
 
-        with concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
-                                                    initializer=worker_setup) as pool:
-            futures = [pool.submit(_run_member, batch, m, tuple(cases), tuple(seeds)) for m in range(count)]
-            for future in concurrent.futures.as_completed(futures):
-                m, runs = future.result()
-                done[m] = runs
-                if progress:
-                    progress()
+        def finished(result: tuple[int, dict]) -> None:
+            done[result[0]] = result[1]
+            if progress:
+                progress()
+
+        run_forked([(_run_member, (batch, m, tuple(cases), tuple(seeds))) for m in range(count)], workers, finished)
     return [done[m] for m in range(count)]
 
 

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import add_common_arguments, progress_bar
+from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
 from twin.physics.gears import lewis_safe_load
 from twin.physics.model import Orientation
 from twin.physics.ticks import whole_ticks
@@ -69,8 +69,7 @@ def gear_load_study(*, pressures_kpa: Sequence[float] = (300.0, 700.0), payloads
     rows = []
     if bar is not None:
         bar.reset(total=len(scenarios))
-    for r in run_many(scenarios, progress=None if bar is None else lambda done, ticks: bar.update(
-            len(scenarios) * done // ticks - bar.n)):  # one batch: its scenarios advance together
+    for r in run_many(scenarios, progress=batch_progress(bar, len(scenarios))):
         tr = r.trace
         speed = np.abs(np.gradient(tr.rack_position, tr.time))
         row = {"controller": r.scenario.controller, "trajectory": r.scenario.trajectory,

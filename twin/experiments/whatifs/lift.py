@@ -13,7 +13,7 @@ import numpy as np
 
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import THESIS_PAYLOADS_G
-from twin.experiments.whatifs.common import add_common_arguments, list_flag, progress_bar
+from twin.experiments.whatifs.common import add_common_arguments, batch_progress, list_flag, progress_bar
 from twin.physics import friction
 from twin.physics.model import Orientation
 from twin.physics.params import NOMINAL_PARAMS, JointParams
@@ -31,15 +31,18 @@ def lift_limit_closed_form(params: JointParams, supply_pressure: float) -> float
     beats everywhere in LIFT_SPAN_DEG (valves fully open, at vanishing speed); negative if not even
     the bare link rises:
 
-        (P A - F_f(y)) r_s = (m L + m_link L / 2) g sin(theta),  y = theta r_s,
+        (P A - F_f(y)) r_s = (1 + mu_L) (m L + m_link L / 2) g sin(theta),  y = theta r_s,
         F_f = max(F_c(y), stiction)   (the rack starts each lift from rest)
-    """
+
+    with mu_L the load friction (:func:`twin.physics.friction.load_friction`: the gravity load the
+    gears carry costs mu_L of itself again in friction; 0 on the thesis plant)."""
     r_s, length = params.gears.spur_radius, params.masses.link_length
     theta = np.radians(np.linspace(*LIFT_SPAN_DEG, 401))
     y = theta * r_s
     resisting = np.maximum(friction.coulomb_force(params.friction, y, np.ones_like(y)), params.friction.stiction)
     torque = (supply_pressure * params.cylinder.bore_area - resisting) * r_s
-    mass = torque / (params.gravity * length * np.sin(theta)) - params.masses.link_mass / 2
+    carried = 1.0 + params.friction.load_friction  # the gravity load plus its load friction
+    mass = torque / (carried * params.gravity * length * np.sin(theta)) - params.masses.link_mass / 2
     return float(np.min(mass))
 
 
@@ -84,13 +87,6 @@ def _bisection_steps(closed: np.ndarray, can: np.ndarray, tolerance: float) -> i
     return steps
 
 
-def _count(bar, count: int):
-    """``simulate``'s ``progress(done_ticks, total_ticks)`` for one batch of ``count`` scenarios, shown on
-    ``bar`` in scenarios (the batch's scenarios advance together)."""
-    start = bar.n
-    return lambda done, ticks: bar.update(start + count * done // ticks - bar.n)
-
-
 def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", tolerance: float = 0.005,
                bar=None) -> Outcome:
     """``bar`` (a tqdm bar, optional) is given the number of scenarios before any runs, then counts them."""
@@ -102,7 +98,7 @@ def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", to
         bar.reset(total=2 * n + int(np.sum(closed > 0)) * _bisection_steps(closed, closed > 0, tolerance))
 
     def lifts(payloads: np.ndarray, at: np.ndarray) -> np.ndarray:
-        return _lifts(payloads, at, plant_name, progress=None if bar is None else _count(bar, len(at)))
+        return _lifts(payloads, at, plant_name, progress=batch_progress(bar, len(at)))
 
     first = lifts(np.concatenate([np.zeros(n), np.full(n, THESIS_PAYLOAD)]), np.concatenate([pressures, pressures]))
     bare_link_lifts, payload_lifts = first[:n], first[n:]  # the payload itself, not read off the bisection

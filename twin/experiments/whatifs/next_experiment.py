@@ -119,9 +119,8 @@ def sine_batch(plant, cases: tuple, seeds: tuple) -> dict:
     scenarios = [Scenario(None, 4, plant=plant, seed=s, supply_pressure=SINE["supply"]) for s in seeds]
     results = simulate(scenarios, controllers=[sine] * len(scenarios), nthread=1,
                        start_positions=np.full(len(seeds), np.radians(SINE["start_deg"]) * r_s))
-    out = {}
+    out, per_bin = {}, int(round(SINE_BIN / plant.timestep))
     for s, r in zip(seeds, results, strict=True):
-        per_bin = int(round(SINE_BIN / plant.timestep))
         y = r.trace.measured_position
         means = y[: len(y) // per_bin * per_bin].reshape(-1, per_bin).mean(axis=1)
         out["slow-sine", s] = float(np.degrees(np.sum(np.abs(np.diff(means))) / r_s))

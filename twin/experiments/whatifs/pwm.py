@@ -11,7 +11,7 @@ from collections.abc import Sequence
 
 from twin.batch.tables import summarise
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import add_common_arguments, list_flag, progress_bar
+from twin.experiments.whatifs.common import add_common_arguments, batch_progress, list_flag, progress_bar
 from twin.physics.valves import ValveModel
 from twin.plants import Plant, plant
 from twin.sim import report
@@ -55,8 +55,7 @@ def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = (1, 
     if bar is not None:
         bar.reset(total=len(cases))
     results = simulate([s for s, _ in cases], controllers=[controllers[s.controller] for s, _ in cases],
-                       progress=None if bar is None else lambda done, ticks: bar.update(
-                           len(cases) * done // ticks - bar.n))  # one batch: its scenarios advance together
+                       progress=batch_progress(bar, len(cases)))
     records = [{**report.summary(r), "pwm_period_ms": ms, "status": "failed" if r.warnings else "ok"}
                for r, (_, ms) in zip(results, cases, strict=True)]
     rows = summarise(records)

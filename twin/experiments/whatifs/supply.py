@@ -15,7 +15,7 @@ import numpy as np
 from twin.batch.tables import summarise
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import add_common_arguments, progress_bar
+from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
 from twin.physics.params import NOMINAL_PARAMS
 from twin.plants import Plant, plant
 from twin.sim import report
@@ -46,8 +46,7 @@ def supply_study(*, trajectories: Sequence[int] = (1, 3), seeds: int = 3, plant_
              for m in SUPPLY_MODELS for c in MODEL_BASED_CONTROLLERS for t in trajectories for s in range(seeds)]
     if bar is not None:
         bar.reset(total=len(cases))
-    results = run_many([s for s, _ in cases], progress=None if bar is None else lambda done, ticks: bar.update(
-        len(cases) * done // ticks - bar.n))  # one batch: its scenarios advance together
+    results = run_many([s for s, _ in cases], progress=batch_progress(bar, len(cases)))
     records = [{**report.summary(r), "pwm_period_ms": None, "status": "failed" if r.warnings else "ok"}
                for r in results]
     model_of = {variant.name: model for model, variant in variants.items()}
