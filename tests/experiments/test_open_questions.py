@@ -84,6 +84,31 @@ def test_breakaway_map_reads_each_members_breakaway():
             assert abs(runs["breakaway-map", s] - expected) < step + 3 * 0.5 / math.sqrt(3 * 8) / 1.2566e-5
 
 
+@pytest.mark.slow  # loaded breakaway ladders on two members: ~5 s on 2 cores
+def test_loaded_breakaway_map_reads_breakaway_plus_the_load_and_its_friction():
+    """With 13.5 g on the vertical link the pair must break away and lift: at each rest position theta
+    the threshold is (F_s + (1 + mu_L) G(theta)) / A, G = (m L + m_link L / 2) g sin(theta) / r_s, so
+    members that differ only in their load friction read apart by (mu_1 - mu_2) mean(G) / A."""
+    from twin.plants.as_built import as_built_plant, calibrated_values
+
+    step = 5e3
+    theta = np.radians(next_experiment.MAP_ANGLES_DEG)
+    readings = {}
+    for mu in (0.0, 0.45):
+        member = as_built_plant({**calibrated_values(), "load_friction": mu}, name=f"as-built mu {mu}")
+        p = member.params
+        gravity = ((next_experiment.LOADED_PAYLOAD + p.masses.link_mass / 2) * p.masses.link_length * p.gravity
+                   * np.sin(theta) / p.gears.spur_radius)
+        expected = np.mean((p.friction.stiction + (1 + mu) * gravity) / p.cylinder.bore_area)
+        runs = next_experiment.breakaway_batch(member, ((step,),), (100, 101), loaded=True)
+        readings[mu] = np.array([runs["loaded-breakaway-map", s] for s in (100, 101)])
+        for reading in readings[mu]:
+            # the first step at or above it; the map's 0.5 N scatter averages over 8 positions to ~6 kPa
+            assert abs(reading - expected) < step + 3 * 0.5 / math.sqrt(3 * 8) / p.cylinder.bore_area
+    gap = 0.45 * np.mean(gravity) / p.cylinder.bore_area  # the same seeds: the same maps
+    np.testing.assert_allclose(readings[0.45] - readings[0.0], gap, atol=step)
+
+
 @pytest.mark.slow  # three commands on a small ensemble: ~40 s on 2 cores
 def test_open_question_commands_write_csv_plot_and_answer(tmp_path, capsys):
     assert main(["whatif", "pva-rate", "--out", str(tmp_path / "rate"), "--members", "2", "--seeds", "1",

@@ -2,7 +2,8 @@
 twin's Chapter 6 predictions most, per hour of rig time (value of information).
 
 The calibration ensemble holds the parameter sets that fit the published measurements about equally
-well (they differ most in the breakaway force, 1.0-2.2 N). Each candidate experiment is simulated on
+well (they differ in the breakaway force and in the load friction, which only a loaded gear train
+shows). Each candidate experiment is simulated on
 every member, over several seeds (each seed is another joint: another static-friction map and
 sensor noise), and reduced to one number, its virtual measurement:
 
@@ -11,6 +12,12 @@ sensor noise), and reduced to one number, its virtual measurement:
     duty; the supply pressure raised in steps of ``--pressure-step`` from 40 kPa until the joint
     moves (the Hall reading leaves its rest by more than :data:`MOVED`). Measurement: the mean over
     the positions of the lowest step that moved it, kPa.
+``loaded-breakaway-map``
+    the same map with the joint on its side and the 13.5 g payload on the link (the Chapter 6
+    vertical set-up): at each rest position the pair must lift the payload as well as break away,
+    so the threshold is (F_s + (1 + mu_L) G(theta)) / A, with G the payload's and the link's
+    gravity load at the rack and mu_L the load friction; it moves only upwards counts (at the lowest
+    steps the payload pulls the joint down through the open pair). Measurement: as the map's.
 ``slow-sine``
     the thesis's open-loop reversing duty sine (§4.6), slower and at a low supply: 60 % amplitude,
     4 s period, 150 kPa, from mid-stroke for 6 s. Measurement: the distance the joint travelled
@@ -44,7 +51,8 @@ from twin.experiments.whatifs.common import progress_bar
 from viz.figures import finish_panels, plt
 
 COLUMNS = ("experiment", "cell", "band_width_before_deg", "band_width_after_deg", "rig_hours")
-EXPERIMENTS = ("breakaway-map", "slow-sine")
+EXPERIMENTS = ("breakaway-map", "loaded-breakaway-map", "slow-sine")
+LOADED_PAYLOAD = 13.5e-3  # kg at the link tip, vertical: the heaviest Chapter 6 payload (SPEC §9)
 LADDER_START = 40e3  # Pa, the first supply setting tried
 LADDER_TOP = 320e3  # Pa, above the 245 kPa where the real joint always broke away
 MAP_ANGLES_DEG = tuple(np.linspace(20.0, 160.0, 8))  # rest positions, as the Hall sensor reads them
@@ -56,6 +64,7 @@ RIG_TIME = {  # hours; assumptions, not from the thesis
     "breakaway_step": 20.0 / 3600,  # set the regulator, wait for the supply to settle, open the pair, look
     "breakaway_reposition": 60.0 / 3600,  # move the joint to the next rest position
     "sine_run": 90.0 / 3600,  # one 6 s run and the reset before the next
+    "turn_and_load": 0.25,  # the loaded map: turn the joint on its side, fix the payload to the link
 }
 SINE_RUNS = 5  # the thesis's five runs
 
@@ -65,15 +74,20 @@ def ladder(step: float) -> np.ndarray:
     return LADDER_START + step * np.arange(int(math.floor((LADDER_TOP - LADDER_START) / step + 1e-9)) + 1)
 
 
-def breakaway_batch(plant, cases: tuple, seeds: tuple) -> dict:
-    """The breakaway map on ``plant`` for each seed: {("breakaway-map", seed): mean threshold, Pa} and the
-    trials it took: {("breakaway-trials", seed): steps tried}. ``cases`` = ((step,),). Bisection on the
-    ladder finds the lowest step that moves the joint (motion is monotone in the supply), one batch per
-    round over every seed and position."""
+def breakaway_batch(plant, cases: tuple, seeds: tuple, *, loaded: bool = False) -> dict:
+    """The breakaway map on ``plant`` for each seed: {(name, seed): mean threshold, Pa} and the trials
+    it took: {(name + "-trials", seed): steps tried}, with ``name`` "breakaway-map", or with ``loaded``
+    "loaded-breakaway-map" (vertical, :data:`LOADED_PAYLOAD` on the link; only a move upwards, against
+    the payload, counts). ``cases`` = ((step,),). Bisection on the ladder finds the lowest step that
+    moves the joint (motion is monotone in the supply), one batch per round over every seed and
+    position."""
     from controllers.open_loop import OpenLoop
+    from twin.physics.model import Orientation
     from twin.sim.scenario import Scenario
     from twin.sim.simulation import simulate
 
+    name = "loaded-breakaway-map" if loaded else "breakaway-map"
+    load = {"payload": LOADED_PAYLOAD, "orientation": Orientation.VERTICAL} if loaded else {}
     (step,) = cases[0]
     settings = ladder(step)
     r_s = plant.params.gears.spur_radius
@@ -85,12 +99,13 @@ def breakaway_batch(plant, cases: tuple, seeds: tuple) -> dict:
     while np.any(high - low > 1):
         open_ = np.flatnonzero(high - low > 1)
         mid = (low[open_] + high[open_]) // 2
-        scenarios = [Scenario(None, 2, plant=plant, seed=jobs[j][0], supply_pressure=float(settings[m]))
+        scenarios = [Scenario(None, 2, plant=plant, seed=jobs[j][0], supply_pressure=float(settings[m]), **load)
                      for j, m in zip(open_, mid, strict=True)]
         results = simulate(scenarios, controllers=[opener] * len(scenarios), nthread=1,
                            start_positions=np.array([jobs[j][1] for j in open_]))
         for j, m, r in zip(open_, mid, results, strict=True):
-            moved = np.max(np.abs(r.trace.measured_position - r.trace.measured_position[0])) > MOVED
+            travel = r.trace.measured_position - r.trace.measured_position[0]
+            moved = np.max(travel if loaded else np.abs(travel)) > MOVED
             if moved:
                 high[j] = m
             else:
@@ -100,8 +115,8 @@ def breakaway_batch(plant, cases: tuple, seeds: tuple) -> dict:
     out = {}
     for k, s in enumerate(seeds):
         mine = slice(k * len(starts), (k + 1) * len(starts))
-        out["breakaway-map", s] = float(np.mean(threshold[mine]))
-        out["breakaway-trials", s] = float(np.sum(high[mine] + 1))  # stepping up from the bottom, as on the rig
+        out[name, s] = float(np.mean(threshold[mine]))
+        out[name + "-trials", s] = float(np.sum(high[mine] + 1))  # stepping up from the bottom, as on the rig
     return out
 
 
@@ -128,7 +143,8 @@ def sine_batch(plant, cases: tuple, seeds: tuple) -> dict:
 
 
 def experiment_batch(plant, cases: tuple, seeds: tuple) -> dict:
-    return {**breakaway_batch(plant, cases, seeds), **sine_batch(plant, cases, seeds)}
+    return {**breakaway_batch(plant, cases, seeds), **breakaway_batch(plant, cases, seeds, loaded=True),
+            **sine_batch(plant, cases, seeds)}
 
 
 def weighted_band(values: np.ndarray, weights: np.ndarray) -> float:
@@ -166,10 +182,15 @@ def refit_widths(measurements: np.ndarray, predictions: np.ndarray) -> tuple[np.
     return before, after / (members * seeds), sigma
 
 
-def rig_hours(trials_per_map: float) -> dict[str, float]:
-    """Rig time of each experiment (hours), from :data:`RIG_TIME`; the map's steps are the simulated ones."""
-    return {"breakaway-map": RIG_TIME["setup"] + trials_per_map * RIG_TIME["breakaway_step"]
-            + len(MAP_ANGLES_DEG) * RIG_TIME["breakaway_reposition"],
+def rig_hours(trials_per_map: dict[str, float]) -> dict[str, float]:
+    """Rig time of each experiment (hours), from :data:`RIG_TIME`; ``trials_per_map`` holds each map's
+    mean number of pressure steps, the simulated ones."""
+    def mapping(name: str) -> float:
+        return (RIG_TIME["setup"] + trials_per_map[name] * RIG_TIME["breakaway_step"]
+                + len(MAP_ANGLES_DEG) * RIG_TIME["breakaway_reposition"])
+
+    return {"breakaway-map": mapping("breakaway-map"),
+            "loaded-breakaway-map": mapping("loaded-breakaway-map") + RIG_TIME["turn_and_load"],
             "slow-sine": RIG_TIME["setup"] + SINE_RUNS * RIG_TIME["sine_run"]}
 
 
@@ -193,7 +214,8 @@ def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure
     predicted = ensemble.over_ensemble(ensemble.cells_batch, ROBUSTNESS_CELLS, seeds=predicted_seeds,
                                        workers=workers, members=count, progress=step)
     predictions = np.array([ensemble.member_means(predicted, cell, predicted_seeds) for cell in ROBUSTNESS_CELLS]).T
-    trials = float(np.mean([runs["breakaway-trials", s] for runs in measured for s in seed_list]))
+    trials = {name: float(np.mean([runs[name + "-trials", s] for runs in measured for s in seed_list]))
+              for name in ("breakaway-map", "loaded-breakaway-map")}
     hours = rig_hours(trials)
     rows, summary = [], {}
     for name in EXPERIMENTS:
@@ -208,7 +230,7 @@ def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure
 
 
 def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_seeds: int, pressure_step: float,
-            trials: float) -> str:
+            trials: dict[str, float]) -> str:
     lines = [f"{members} calibration ensemble members, {seeds} virtual rig runs each; Chapter 6 predictions from "
              f"{prediction_seeds} seeds per member. Band = 10-90 % of the members' mean RMSE (weighted inverse distribution: with equal weights, all members)."]
     score = {}
@@ -217,8 +239,8 @@ def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_
         before, after = s["before"], s["after"]
         kept = float(np.sum(after) / np.sum(before)) if np.sum(before) > 0 else 1.0
         score[name] = (1.0 - kept) / hours[name]
-        unit = "kPa" if name == "breakaway-map" else "deg"
-        scale = 1e-3 if name == "breakaway-map" else 1.0
+        unit = "kPa" if name in trials else "deg"
+        scale = 1e-3 if name in trials else 1.0
         member_means = s["values"].mean(axis=1) * scale
         widest = int(np.argmax(before))
         order = np.sort(s["values"].mean(axis=1))
@@ -226,14 +248,17 @@ def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_
         lines.append(
             f"{name}: measurement {member_means.min():.1f}-{member_means.max():.1f} {unit} across members, spread "
             f"within a member {s['sigma'] * scale:.1f} {unit}, so it tells the {len(order)} members apart in "
-            f"{groups} groups; bands narrow to {kept:.0%} of their width in sum "
+            f"{groups} group{'s' if groups > 1 else ''}; bands narrow to {kept:.0%} of their width in sum "
             f"(widest cell {cell_label(ROBUSTNESS_CELLS[widest])}: {before[widest]:.2f} -> "
             f"{after[widest]:.2f} deg); rig time {hours[name]:.1f} h; narrowing {score[name]:.2f} per hour.")
     best = max(score, key=score.get)
     lines.append(f"Answer: run the {best} experiment next: it narrows the predictions most per hour of rig time.")
     lines.append(f"Assumed: supply steps of {pressure_step / 1e3:g} kPa from {LADDER_START / 1e3:g} kPa (the "
                  f"air-over-water supply set by its air regulator; not finer), {len(MAP_ANGLES_DEG)} rest positions "
-                 f"20-160 deg, {trials:.0f} steps per map on average; rig time: {RIG_TIME['setup']:g} h to set up, "
+                 f"20-160 deg ({LOADED_PAYLOAD * 1e3:g} g on the link, vertical, for the loaded map), "
+                 f"{trials['breakaway-map']:.0f} and {trials['loaded-breakaway-map']:.0f} steps per map on average; "
+                 f"rig time: {RIG_TIME['setup']:g} h to set up (+{RIG_TIME['turn_and_load']:g} h to turn the joint "
+                 f"on its side and fix the payload), "
                  f"{RIG_TIME['breakaway_step'] * 3600:g} s a pressure step, {RIG_TIME['breakaway_reposition'] * 3600:g} s "
                  f"to move to the next rest position, {RIG_TIME['sine_run'] * 3600:g} s a sine run ({SINE_RUNS} runs); the "
                  f"ensemble's "
@@ -247,9 +272,12 @@ def plot_next_experiment(outcome: Outcome, path: pathlib.Path) -> None:
     fig, ax = plt.subplots(figsize=(12, 4.8), constrained_layout=True)
     x = np.arange(len(cells))
     first = summary[EXPERIMENTS[0]]["before"]
-    ax.bar(x - 0.27, first, 0.27, color="0.6", label="before (calibration ensemble)")
-    for offset, name, colour in ((0.0, "breakaway-map", "tab:green"), (0.27, "slow-sine", "tab:orange")):
-        ax.bar(x + offset, summary[name]["after"], 0.27, color=colour, label=f"after the {name} experiment")
+    width = 0.2
+    ax.bar(x - 1.5 * width, first, width, color="0.6", label="before (calibration ensemble)")
+    colours = {"breakaway-map": "tab:green", "loaded-breakaway-map": "tab:blue", "slow-sine": "tab:orange"}
+    for k, name in enumerate(EXPERIMENTS):
+        ax.bar(x + (k - 0.5) * width, summary[name]["after"], width, color=colours[name],
+               label=f"after the {name} experiment")
     ax.set_xticks(x, cells, rotation=70, ha="right", fontsize=7)
     ax.set_ylabel("width of the 10-90 % band (deg)")
     ax.set_title("Chapter 6 prediction bands before and after refitting on one more experiment", fontsize=9)
