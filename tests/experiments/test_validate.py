@@ -80,7 +80,8 @@ def test_validate_without_a_calibration_is_a_one_line_error_and_writes_nothing(t
     assert not (tmp_path / "v").exists()
 
 
-def _fake(ratio_13_5: float, lag_within: bool, stalled: int) -> validate.Validation:
+def _fake(ratio_13_5: float, lag_within: bool, stalled: int, members: list | None = None,
+          per_member: list | None = None) -> validate.Validation:
     row = validate._row
     rows = [row("chapter 5 experiment", c, t, 0.0, "horizontal", "as-built", m, m * k, 0.1, abs(k - 1) <= 0.2)
             for c, t, m, k in (("pva", 1, 4.2, 0.4), ("ffpva", 1, 1.4, 1.0), ("smc", 1, 1.19, 0.9),
@@ -91,8 +92,8 @@ def _fake(ratio_13_5: float, lag_within: bool, stalled: int) -> validate.Validat
                     120.0 if lag_within else 70.0, None, lag_within))
     prediction = [{"controller": "smc", "trajectory": 3, "payload_g": 13.5, "orientation": "vertical",
                    "twin_mean": 2.9, "band_p10": 2.8, "band_p50": 2.9, "band_p90": 3.1, "stalled_runs": stalled}]
-    detail = {"members": [{"stiction": 1.0, "load_friction": 0.15}, {"stiction": 2.2, "load_friction": 0.45}],
-              "runs": 10, "per_member": [[2.8], [3.1]]}
+    detail = {"members": members or [{"stiction": 1.0, "load_friction": 0.15}, {"stiction": 2.2, "load_friction": 0.45}],
+              "runs": 10, "per_member": per_member or [[2.8], [3.1]]}
     return validate.Validation(rows=rows, prediction=prediction, prediction_detail=detail,
                                failed=0, stalled={("smc", 1, 13.5, "vertical"): 0})
 
@@ -111,3 +112,16 @@ def test_report_says_plainly_what_misses_and_what_the_runs_show():
     other = validate.report(_fake(1.0, lag_within=True, stalled=3))
     assert "lags the model, as the real joint did" in other and "Within tolerance." in other
     assert "some members' runs stall" in other
+
+
+def test_report_judges_the_dependence_on_every_member_not_the_band_alone():
+    """One member of eight set apart by its load friction lies mostly outside the interpolated 10-90 %
+    band (2.8-3.1 here); the report still says the cell turns on it, names that member and lists the
+    members' range beside the band."""
+    members = [{"stiction": 1.5, "load_friction": 0.3}] * 7 + [{"stiction": 1.5, "load_friction": 0.45}]
+    per_member = [[2.8], [2.85], [2.9], [2.9], [2.95], [3.0], [3.1], [4.5]]
+    text = validate.report(_fake(1.0, lag_within=True, stalled=0, members=members, per_member=per_member))
+    assert "members' means span 2.80-4.50 deg" in text
+    assert "to the one with 1.50 N and 0.45 N/N" in text
+    assert "**turns on them** there" in text and "does not turn on them" not in text
+    assert "| 2.90 | 2.80 | 2.90 | 3.10 | 2.80-4.50 | 0 |" in text
