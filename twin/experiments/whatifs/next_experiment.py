@@ -11,13 +11,17 @@ sensor noise), and reduced to one number, its virtual measurement:
     the joint at rest at several positions across the stroke; the pair V1 + V4 opened at 100 %
     duty; the supply pressure raised in steps of ``--pressure-step`` from 40 kPa until the joint
     moves (the Hall reading leaves its rest by more than :data:`MOVED`). Measurement: the mean over
-    the positions of the lowest step that moved it, kPa.
+    the positions of the lowest step that moved it, kPa. At each position the threshold is the rest
+    limit over the bore area, max(F_s(y), F_c(y)) / A: the breakaway map, or eq. 4.5.7's Coulomb
+    level where that is higher (at 2 of the 8 positions on the committed preset).
 ``loaded-breakaway-map``
     the same map with the joint on its side and the 13.5 g payload on the link (the Chapter 6
     vertical set-up): at each rest position the pair must lift the payload as well as break away,
-    so the threshold is (F_s + (1 + mu_L) G(theta)) / A, with G the payload's and the link's
-    gravity load at the rack and mu_L the load friction; it moves only upwards counts (at the lowest
-    steps the payload pulls the joint down through the open pair). Measurement: as the map's.
+    so the threshold is (max(F_s(y), F_c(y)) + (1 + mu_L) G(theta)) / A, with G the payload's and
+    the link's gravity load at the rack and mu_L the load friction. Only a move upwards, against the
+    payload, counts: a slip downwards would be the payload winning, not a breakaway (within the
+    fitted box it does not happen: G is at most about 1 N, less than the breakaway plus what 40 kPa
+    pushes). Measurement: as the map's.
 ``slow-sine``
     the thesis's open-loop reversing duty sine (§4.6), slower and at a low supply: 60 % amplitude,
     4 s period, 150 kPa, from mid-stroke for 6 s. Measurement: the distance the joint travelled
