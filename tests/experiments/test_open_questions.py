@@ -119,11 +119,11 @@ def test_loaded_breakaway_map_reads_breakaway_plus_the_load_and_its_friction():
         p = exact.params
         coulomb, gravity = _rest_limits(p, load=next_experiment.LOADED_PAYLOAD)
         expected = np.mean((coulomb + (1 + mu) * gravity) / p.cylinder.bore_area)
-        runs = next_experiment.breakaway_batch(exact, ((step,),), (100, 101), loaded=True)
+        runs = next_experiment.loaded_breakaway_batch(exact, ((step,),), (100, 101))
         for s in (100, 101):
             assert expected - 1e3 < runs["loaded-breakaway-map", s] < expected + step + 8e3, (mu, s, expected)
         mapped = as_built_plant(values, name=f"as-built mu {mu}")
-        runs = next_experiment.breakaway_batch(mapped, ((step,),), (100, 101), loaded=True)
+        runs = next_experiment.loaded_breakaway_batch(mapped, ((step,),), (100, 101))
         readings[mu] = np.array([runs["loaded-breakaway-map", s] for s in (100, 101)])
     gap = 0.45 * np.mean(gravity) / p.cylinder.bore_area
     np.testing.assert_allclose(readings[0.45] - readings[0.0], gap, atol=step)

@@ -165,6 +165,12 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     return rows, own, detail
 
 
+def member_means(detail: dict) -> np.ndarray:
+    """Each ensemble member's five-run mean RMSE per T3 cell, (cells, members), from ``prediction``'s
+    detail."""
+    return np.array(detail["per_member"]).T
+
+
 @dataclasses.dataclass
 class Validation:
     rows: list[dict]
@@ -253,16 +259,16 @@ def _why(v: Validation) -> list[str]:
     # Judged on every member's mean, not on the 10-90 % band alone: with eight members the band's ends are
     # interpolated between the two lowest and the two highest, so one member set apart by a parameter that
     # the data do not pin would fall mostly outside it.
-    per_member = np.array(v.prediction_detail["per_member"])  # (members, cells)
-    span = per_member.max(axis=0) - per_member.min(axis=0)
+    means = member_means(v.prediction_detail)
+    span = means.max(axis=1) - means.min(axis=1)
     k = int(np.argmax(span / np.array([r["band_p50"] for r in v.prediction])))
     widest, relative = v.prediction[k], span[k] / v.prediction[k]["band_p50"]
-    lowest, highest = members[int(np.argmin(per_member[:, k]))], members[int(np.argmax(per_member[:, k]))]
+    lowest, highest = members[int(np.argmin(means[k]))], members[int(np.argmax(means[k]))]
     lines.append(f"- **The breakaway and the load friction**: the ensemble spans {low:.2f}-{high:.2f} N of "
                  f"breakaway and {load_low:.2f}-{load_high:.2f} N/N of load friction, fitting the "
                  f"measurements about equally well. The T3 cell that depends on them most is "
                  f"{CONTROLLER_LABELS[widest['controller']]} {widest['payload_g']:g} g {widest['orientation']}: its "
-                 f"members' means span {per_member[:, k].min():.2f}-{per_member[:, k].max():.2f} deg ({relative:.0%} "
+                 f"members' means span {means[k].min():.2f}-{means[k].max():.2f} deg ({relative:.0%} "
                  f"of the median; 10-90 % band {widest['band_p10']:.2f}-{widest['band_p90']:.2f}), from the member with "
                  f"{lowest['stiction']:.2f} N and {lowest['load_friction']:.2f} N/N to the one with "
                  f"{highest['stiction']:.2f} N and {highest['load_friction']:.2f} N/N. So within what the data allow "
@@ -352,7 +358,7 @@ def report(v: Validation) -> str:
               + ", ".join(f"{m['load_friction']:.2f}" for m in d["members"]) + ".", "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | members (lowest-highest) | stalled |",
               "|---|---|---|---|---|---|---|---|---|"]
-    for r, means in zip(v.prediction, np.array(d["per_member"]).T, strict=True):
+    for r, means in zip(v.prediction, member_means(d), strict=True):
         lines.append(f"| {CONTROLLER_LABELS[r['controller']]} | {r['payload_g']:g} g | {r['orientation']} | "
                      f"{_fmt(r['twin_mean'])} | {_fmt(r['band_p10'])} | {_fmt(r['band_p50'])} | {_fmt(r['band_p90'])} | "
                      f"{_fmt(float(means.min()))}-{_fmt(float(means.max()))} | {r['stalled_runs']} |")
@@ -433,14 +439,13 @@ class ValidateExperiment(Experiment):
             v = validate(workers=args.workers, progress=lambda: bar.update(1))
         within = sum(r["within_tolerance"] for r in v.rows)
         stalled = sum(r["stalled_runs"] for r in v.prediction)
-        per_member = np.array(v.prediction_detail["per_member"]).T  # (cells, members)
         answer = (f"{within} of {len(v.rows)} comparisons within tolerance (see validation.md). T3 prediction over "
                   f"{len(v.prediction_detail['members'])} ensemble members, committed [10-90 % band; lowest-highest "
                   "member]: "
                   + "; ".join(f"{CONTROLLER_LABELS[r['controller']]} {r['payload_g']:g} g {r['orientation'][0].upper()} "
                               f"{r['twin_mean']:.2f} [{r['band_p10']:.2f}-{r['band_p90']:.2f}; "
                               f"{means.min():.2f}-{means.max():.2f}]"
-                              for r, means in zip(v.prediction, per_member, strict=True))
+                              for r, means in zip(v.prediction, member_means(v.prediction_detail), strict=True))
                   + f"; {stalled} stalled runs.")
         return Outcome(rows=v.rows, answer=answer, failed=v.failed, detail=v)
 

@@ -56,6 +56,7 @@ from viz.figures import finish_panels, plt
 
 COLUMNS = ("experiment", "cell", "band_width_before_deg", "band_width_after_deg", "rig_hours")
 EXPERIMENTS = ("breakaway-map", "loaded-breakaway-map", "slow-sine")
+MAPS = EXPERIMENTS[:2]  # the supply-pressure ladders: measured in Pa, their rig time counted in steps
 LOADED_PAYLOAD = 13.5e-3  # kg at the link tip, vertical: the heaviest Chapter 6 payload (SPEC §9)
 LADDER_START = 40e3  # Pa, the first supply setting tried
 LADDER_TOP = 320e3  # Pa, above the 245 kPa where the real joint always broke away
@@ -78,20 +79,32 @@ def ladder(step: float) -> np.ndarray:
     return LADDER_START + step * np.arange(int(math.floor((LADDER_TOP - LADDER_START) / step + 1e-9)) + 1)
 
 
-def breakaway_batch(plant, cases: tuple, seeds: tuple, *, loaded: bool = False) -> dict:
-    """The breakaway map on ``plant`` for each seed: {(name, seed): mean threshold, Pa} and the trials
-    it took: {(name + "-trials", seed): steps tried}, with ``name`` "breakaway-map", or with ``loaded``
-    "loaded-breakaway-map" (vertical, :data:`LOADED_PAYLOAD` on the link; only a move upwards, against
-    the payload, counts). ``cases`` = ((step,),). Bisection on the ladder finds the lowest step that
-    moves the joint (motion is monotone in the supply), one batch per round over every seed and
-    position."""
-    from controllers.open_loop import OpenLoop
+def breakaway_batch(plant, cases: tuple, seeds: tuple) -> dict:
+    """The breakaway map on ``plant`` for each seed: {("breakaway-map", seed): mean threshold, Pa} and the
+    trials it took: {("breakaway-map-trials", seed): steps tried}. ``cases`` = ((step,),); any move counts."""
+    return _ladder_map(plant, cases, seeds, name="breakaway-map", load={},
+                       moved=lambda travel: np.max(np.abs(travel)) > MOVED)
+
+
+def loaded_breakaway_batch(plant, cases: tuple, seeds: tuple) -> dict:
+    """The same map with the joint vertical and :data:`LOADED_PAYLOAD` on the link, keyed
+    "loaded-breakaway-map"; only a move upwards, against the payload, counts."""
     from twin.physics.model import Orientation
+
+    return _ladder_map(plant, cases, seeds, name="loaded-breakaway-map",
+                       load={"payload": LOADED_PAYLOAD, "orientation": Orientation.VERTICAL},
+                       moved=lambda travel: np.max(travel) > MOVED)
+
+
+def _ladder_map(plant, cases: tuple, seeds: tuple, *, name: str, load: dict, moved) -> dict:
+    """{(name, seed): mean threshold over the rest positions, Pa; (name + "-trials", seed): steps tried}.
+    ``load``: the scenarios' payload and orientation; ``moved(travel)``: whether a run's Hall travel from
+    rest (m, (ticks,)) counts as a move. Bisection on the ladder finds the lowest step that moves the
+    joint (motion is monotone in the supply), one batch per round over every seed and position."""
+    from controllers.open_loop import OpenLoop
     from twin.sim.scenario import Scenario
     from twin.sim.simulation import simulate
 
-    name = "loaded-breakaway-map" if loaded else "breakaway-map"
-    load = {"payload": LOADED_PAYLOAD, "orientation": Orientation.VERTICAL} if loaded else {}
     (step,) = cases[0]
     settings = ladder(step)
     r_s = plant.params.gears.spur_radius
@@ -108,9 +121,7 @@ def breakaway_batch(plant, cases: tuple, seeds: tuple, *, loaded: bool = False) 
         results = simulate(scenarios, controllers=[opener] * len(scenarios), nthread=1,
                            start_positions=np.array([jobs[j][1] for j in open_]))
         for j, m, r in zip(open_, mid, results, strict=True):
-            travel = r.trace.measured_position - r.trace.measured_position[0]
-            moved = np.max(travel if loaded else np.abs(travel)) > MOVED
-            if moved:
+            if moved(r.trace.measured_position - r.trace.measured_position[0]):
                 high[j] = m
             else:
                 low[j] = m
@@ -147,7 +158,7 @@ def sine_batch(plant, cases: tuple, seeds: tuple) -> dict:
 
 
 def experiment_batch(plant, cases: tuple, seeds: tuple) -> dict:
-    return {**breakaway_batch(plant, cases, seeds), **breakaway_batch(plant, cases, seeds, loaded=True),
+    return {**breakaway_batch(plant, cases, seeds), **loaded_breakaway_batch(plant, cases, seeds),
             **sine_batch(plant, cases, seeds)}
 
 
@@ -219,7 +230,7 @@ def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure
                                        workers=workers, members=count, progress=step)
     predictions = np.array([ensemble.member_means(predicted, cell, predicted_seeds) for cell in ROBUSTNESS_CELLS]).T
     trials = {name: float(np.mean([runs[name + "-trials", s] for runs in measured for s in seed_list]))
-              for name in ("breakaway-map", "loaded-breakaway-map")}
+              for name in MAPS}
     hours = rig_hours(trials)
     rows, summary = [], {}
     for name in EXPERIMENTS:
@@ -243,8 +254,7 @@ def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_
         before, after = s["before"], s["after"]
         kept = float(np.sum(after) / np.sum(before)) if np.sum(before) > 0 else 1.0
         score[name] = (1.0 - kept) / hours[name]
-        unit = "kPa" if name in trials else "deg"
-        scale = 1e-3 if name in trials else 1.0
+        unit, scale = ("kPa", 1e-3) if name in MAPS else ("deg", 1.0)
         member_means = s["values"].mean(axis=1) * scale
         widest = int(np.argmax(before))
         order = np.sort(s["values"].mean(axis=1))
