@@ -311,7 +311,7 @@ def test_live_page_plots_follows_the_server_and_reflows(live_twin, browser, page
     other.close()
     page.wait_for_timeout(300)
     pixels = screenshot(page, "live-120deg.png")
-    assert_scene_rendered(pixels)
+    assert_scene_rendered(pixels, least=200)  # about 480 brass pixels seen here: half, against pose and driver
     shutil.copy(ARTIFACTS / "live-120deg.png", ROOT / "docs" / "viewer.png")  # the docs' picture, 1280x720
 
     # 800x600 after a resize: the panel stays usable and the 3D view still shows the whole mechanism
@@ -320,7 +320,7 @@ def test_live_page_plots_follows_the_server_and_reflows(live_twin, browser, page
     fit = view_fit(page)
     assert fit["panel"] >= 240
     assert_fills(fit)
-    assert_scene_rendered(screenshot(page, "live-800x600.png"), least=120)  # a smaller view
+    assert_scene_rendered(screenshot(page, "live-800x600.png"), least=80)  # a smaller view (about 180 brass pixels seen)
     assert page.evaluate("document.querySelector('canvas[data-chart=\"angle\"]').clientWidth") > 150
 
     for bad in ['{"type": "payload", "grams": 51}', "not json", '{"type": "target", "angle_deg": -5}',
