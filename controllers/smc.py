@@ -67,7 +67,10 @@ class SlidingMode:
         if self._calls % self._slow_every == 0:
             self._held = ffpva_duty(self.nominal, self.gains.pva, measurement, setpoint)
         self._calls += 1
+        return np.clip(self._held + self.switching(measurement, setpoint), -100.0, 100.0)
+
+    def switching(self, measurement: Measurement, setpoint: Setpoint) -> np.ndarray:
+        """The switching term, % (n,): 100 % sat(sigma / phi), sigma = de/dt + lambda e."""
         error = setpoint.position - measurement.position
         sigma = (setpoint.velocity - measurement.velocity) + self.gains.surface_slope * error
-        switching = self.gains.switching_amplitude * np.clip(sigma / self.gains.boundary_layer, -1.0, 1.0)
-        return np.clip(self._held + switching, -100.0, 100.0)
+        return self.gains.switching_amplitude * np.clip(sigma / self.gains.boundary_layer, -1.0, 1.0)

@@ -125,3 +125,46 @@ def test_report_judges_the_dependence_on_every_member_not_the_band_alone():
     assert "to the one with 1.50 N and 0.45 N/N" in text
     assert "**turns on them** there" in text and "does not turn on them" not in text
     assert "| 2.90 | 2.80 | 2.90 | 3.10 | 2.80-4.50 | 0 |" in text
+
+
+def test_report_shows_what_sliding_modes_switching_term_does():
+    v = _fake(1.0, lag_within=True, stalled=0)
+    assert "switching term" not in validate.report(v)  # no parts run: no line
+    v.sliding_mode = {"dead_zone_pct": 26.0, "trajectories": {
+        1: {"as_run_deg": 1.45, "without_switching_deg": 2.07, "switching_rms_pct": 2.75},
+        2: {"as_run_deg": 2.28, "without_switching_deg": 3.32, "switching_rms_pct": 5.11}}}
+    text = validate.report(v)
+    assert ("sliding mode tracks at 1.45 / 2.28 deg, and without its switching term at 2.07 / 3.32 deg "
+            "(FF + PVA: 1.40 / 2.08)") in text
+    assert "no flow below 26 % here" in text and "it adds 2.75 / 5.11 % of duty RMS" in text
+
+
+@pytest.mark.slow  # about 4 s on 2 cores
+def test_sliding_mode_without_its_switching_term_is_ff_pva_at_its_gain_without_compensation():
+    """The decomposition's premise, checked on the as-built plant (T1, one seed): sliding mode with a zero
+    switching term holds u_FF+PVA through each 16 ms period, as FF + PVA does, and has no dead-zone
+    compensation; so it must equal FF + PVA at K_p 50,000 with the compensation off, to the last bit.
+    And the switching term it would add is a few % of duty, not zero and not saturated."""
+    import dataclasses
+
+    import controllers
+    from twin.envs.runner import nominal_model
+    from twin.plants.as_built import as_built_plant, calibrated_values
+    from twin.sim.scenario import Scenario
+    from twin.sim.simulation import simulate
+
+    plant = as_built_plant()
+    nominal = nominal_model(plant)
+    smc = controllers.make_controller("smc", nominal=nominal, gain_set=plant.gain_set, tick=plant.timestep)
+    bare = dataclasses.replace(smc, gains=dataclasses.replace(smc.gains, switching_amplitude=0.0))
+    ffpva = controllers.make_controller("ffpva", nominal=nominal, gain_set=plant.gain_set, tick=plant.timestep)
+    same_gain = dataclasses.replace(ffpva, gains=dataclasses.replace(
+        ffpva.gains, pva=smc.gains.pva, compensation_band=(0.0, 0.0)))
+    first, second = simulate([Scenario("smc", 1, plant=plant, seed=0), Scenario("ffpva", 1, plant=plant, seed=0)],
+                             controllers=[bare, same_gain])
+    assert first.metrics.rmse == second.metrics.rmse and first.metrics.sse == second.metrics.sse
+    parts = validate.sliding_mode_parts(calibrated_values())
+    assert parts["dead_zone_pct"] == pytest.approx(26.0, abs=2.0)
+    for t, part in parts["trajectories"].items():
+        assert 0.5 < part["switching_rms_pct"] < 20.0, t
+        assert part["without_switching_deg"] > part["as_run_deg"], t  # the term is all that lifts it
