@@ -96,9 +96,9 @@ def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_each_prof
 
     def v(f, a=0.01, load=0.2):
         return {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14,
-                "load_friction": load}
+                "load_friction": load, "observer_gain": 100.0}
 
-    assert calibrate.PROFILED == ("load_friction", "stiction")
+    assert calibrate.PROFILED == ("load_friction", "stiction", "observer_gain")
     history = [E(v(2.0), 1.00, "scan"), E(v(1.2), 1.04, "profile"), E(v(2.4), 1.05, "profile"),
                E(v(1.8), 1.02, "simplex"), E(v(1.8), 1.02, "simplex"), E(v(2.5), 1.30, "profile"),
                E(v(1.9, 0.02), 1.01, "simplex")]
@@ -152,8 +152,8 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
 def test_unit_box_maps_onto_the_plausible_bounds():
     assert values_at([0.0] * len(FITTED)) == {f.name: f.low for f in FITTED}
     assert values_at([1.0] * len(FITTED)) == {f.name: f.high for f in FITTED}
-    assert values_at([2.0, -1.0, 0.5, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
-    assert calibrate.unit_of(values_at([0.25, 0.5, 0.75, 1.0, 0.1])) == pytest.approx((0.25, 0.5, 0.75, 1.0, 0.1))
+    assert values_at([2.0, -1.0, 0.5, 0.5, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
+    assert calibrate.unit_of(values_at([0.25, 0.5, 0.75, 1.0, 0.1, 0.6])) == pytest.approx((0.25, 0.5, 0.75, 1.0, 0.1, 0.6))
 
 
 def test_the_breakaway_bound_is_what_245_kpa_could_start_from_rest():
@@ -167,6 +167,8 @@ def test_the_breakaway_bound_is_what_245_kpa_could_start_from_rest():
 
 
 def test_committed_preset_is_inside_its_bounds_and_is_the_as_built_plant():
+    from twin.plants.preset import THESIS_PARAMS
+
     values = calibrated_values()
     for f in FITTED:
         assert f.low <= values[f.name] <= f.high
@@ -175,6 +177,9 @@ def test_committed_preset_is_inside_its_bounds_and_is_the_as_built_plant():
     assert plant.params.chambers.air_fraction == values["air_fraction"]
     assert plant.params.friction.ccw_coulomb_scale == values["ccw_coulomb_scale"]
     assert plant.params.chambers.leak_conductance == values["leak_conductance"]
+    assert plant.params.friction.load_friction == values["load_friction"]
+    assert plant.params.observer.gain == values["observer_gain"]
+    assert as_built_plant(without=["experiment_gains"]).params.observer.gain == THESIS_PARAMS.observer.gain
     assert plant.valve_model is ValveModel.SOLENOID
     members = ensemble_values()
     assert members[0] == values and all(all(f.low <= m[f.name] <= f.high for f in FITTED) for m in members)
@@ -228,8 +233,8 @@ def test_same_seeds_same_fit_whatever_the_workers():
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    # two points along each profiled parameter (the load friction, then the breakaway)
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 4
+    # two points along each profiled parameter (the load friction, the breakaway, the observer gain)
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 6
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)
@@ -239,7 +244,7 @@ def test_same_seeds_same_fit_whatever_the_workers():
 @pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluation (the centre of the box) costs
-    exactly what the committed file says. The whole fit (about 7 min on 2 cores) is
+    exactly what the committed file says. The whole fit (about 8 min on 2 cores) is
     ``twin calibrate --out DIR``; its file equals the committed one (see docs/as-built.md)."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, scan_points=0, simplex_evaluations=0, profile_points=0,

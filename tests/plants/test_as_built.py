@@ -43,7 +43,7 @@ FRICTIONLESS = FrictionParams(viscous=0.0, coulomb_poly=(0.0,), stiction=0.0)
 CONSTANT_SUPPLY = SupplyLineParams()  # the thesis's P_s = P_0
 THESIS_FRICTION = FrictionParams(stiction=0.0)  # eq. 4.5.5 with eq. 4.5.7
 VALUES = {"stiction": 1.5, "air_fraction": 0.01, "ccw_coulomb_scale": 1.1,
-          "leak_conductance": 1e-14, "load_friction": 0.3}
+          "leak_conductance": 1e-14, "load_friction": 0.3, "observer_gain": 100.0}
 
 
 def eq_4_5_7(y: float) -> float:

@@ -29,10 +29,10 @@ Search, deterministic (the same code and seeds give the same file):
 2. Nelder-Mead from the best of them, at most :data:`SIMPLEX_EVALUATIONS` evaluations;
 3. the seed-to-seed noise of the best cost: the best values so far on :data:`NOISE_SEED_SETS`
    (each as many seeds as the fit, disjoint), noise = the sample std of those costs and the fit's;
-4. profiles of the two parameters the vertical predictions turn on (:data:`PROFILED`): the best
-   values with the load friction at :data:`PROFILE_POINTS` points across its box, then the best of
-   all so far with the breakaway likewise; the fitted values are then the lowest cost of all
-   evaluations (a profile point may beat the simplex);
+4. profiles (:data:`PROFILED`): the best values with the load friction at :data:`PROFILE_POINTS`
+   points across its box, then the best of all so far with the breakaway likewise (the two the
+   vertical predictions turn on), then with the observer gain likewise; the fitted values are then the
+   lowest cost of all evaluations (a profile point may beat the simplex);
 5. the ensemble: every evaluated parameter set whose cost is within the noise of the best
    (cost <= best + noise), at most :data:`ENSEMBLE_MAX` of them (the best first, then the
    lowest and highest of each profiled parameter, then by cost).
@@ -71,9 +71,11 @@ SCAN_POINTS = 16  # Sobol points (a power of two)
 SCAN_SEED = 0
 SIMPLEX_EVALUATIONS = 24
 PROFILE_POINTS = 5  # per profiled parameter
-PROFILED = ("load_friction", "stiction")  # in this order; the vertical payload cells turn on both
+PROFILED = ("load_friction", "stiction", "observer_gain")  # in this order; the vertical payload cells turn on
+# the first two, sliding mode and the T1 endings on the third
 ENSEMBLE_MAX = 8
-FILE_VERSION = 5  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction
+FILE_VERSION = 6  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction;
+# 6: the observer gain
 
 
 @dataclasses.dataclass(frozen=True)

@@ -234,7 +234,9 @@ OBSERVER_KINDS = ("first-order", "kalman")
 class ObserverParams:
     """The velocity/acceleration observer: first-order (eq. 5.2.2), or a Kalman filter on the nominal model."""
 
-    gain: float = 100.0  # 1/s, K_OB; not given by the thesis (*inferred*: 16 Hz, below the 31 Hz control Nyquist)
+    # 1/s, K_OB; not given by the thesis (*inferred* for the thesis plant: 16 Hz, below the 31 Hz control Nyquist;
+    # the as-built plant fits it, twin.plants.as_built.FITTED)
+    gain: float = 100.0
     kind: str = "first-order"  # "first-order" (eq. 5.2.2) or "kalman" (twin.physics.sensing.KalmanObserver, SPEC §10)
     # Kalman only: spectral density of the unmodelled acceleration's rate (random walk), (m/s^3)^2 s. A design
     # choice (not from the thesis) that sets how fast the filter follows friction and gravity: 3e3 gave the least
