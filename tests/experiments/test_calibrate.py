@@ -112,6 +112,14 @@ def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_each_prof
     chosen = calibrate.choose_ensemble(loads, loads[0], 0.06, limit=4)
     assert [(e.values["load_friction"], e.values["stiction"]) for e in chosen] == [(0.2, 2.0), (0.1, 1.8), (0.5, 1.8),
                                                                                    (0.2, 1.2)]
+    # round-off is not a value: a set whose observer gain differs from the others' by 1e-13 is no extreme
+    # (the simplex leaves such twins), and the cheaper of two sets sharing an extreme is taken
+    twins = [E(v(2.0), 1.00, "scan"), E(dict(v(2.0), observer_gain=100.0 + 1e-13), 1.05, "simplex"),
+             E(v(2.0, 0.02), 1.02, "simplex")]
+    assert [e.cost for e in calibrate.choose_ensemble(twins, twins[0], 0.06, limit=2)] == [1.00, 1.02]
+    # the cheapest of the sets sharing an extreme value
+    shared = [E(v(2.0), 1.00, "scan"), E(v(1.5, 0.03), 1.04, "simplex"), E(v(1.5, 0.02), 1.02, "simplex")]
+    assert [e.cost for e in calibrate.choose_ensemble(shared, shared[0], 0.06, limit=2)] == [1.00, 1.02]
 
 
 def test_a_failed_run_costs():

@@ -92,7 +92,8 @@ def _fake(ratio_13_5: float, lag_within: bool, stalled: int, members: list | Non
                     120.0 if lag_within else 70.0, None, lag_within))
     prediction = [{"controller": "smc", "trajectory": 3, "payload_g": 13.5, "orientation": "vertical",
                    "twin_mean": 2.9, "band_p10": 2.8, "band_p50": 2.9, "band_p90": 3.1, "stalled_runs": stalled}]
-    detail = {"members": members or [{"stiction": 1.0, "load_friction": 0.15}, {"stiction": 2.2, "load_friction": 0.45}],
+    detail = {"members": members or [{"stiction": 1.0, "load_friction": 0.15, "observer_gain": 340.0},
+                                     {"stiction": 2.2, "load_friction": 0.45, "observer_gain": 340.0}],
               "runs": 10, "per_member": per_member or [[2.8], [3.1]]}
     return validate.Validation(rows=rows, prediction=prediction, prediction_detail=detail,
                                failed=0, stalled={("smc", 1, 13.5, "vertical"): 0})
@@ -108,7 +109,7 @@ def test_report_says_plainly_what_misses_and_what_the_runs_show():
     assert "spans 1.00-2.20 N of breakaway and 0.15-0.45 N/N of load friction" in text
     assert "no run of any member stalls" in text
     assert "does not turn on them" in text  # a 0.3 deg band
-    assert "their load friction (N/N): 0.15, 0.45." in text
+    assert "their load friction (N/N): 0.15, 0.45; their observer gain (1/s): 340, 340." in text
     other = validate.report(_fake(1.0, lag_within=True, stalled=3))
     assert "lags the model, as the real joint did" in other and "Within tolerance." in other
     assert "some members' runs stall" in other
@@ -118,7 +119,8 @@ def test_report_judges_the_dependence_on_every_member_not_the_band_alone():
     """One member of eight set apart by its load friction lies mostly outside the interpolated 10-90 %
     band (2.8-3.1 here); the report still says the cell turns on it, names that member and lists the
     members' range beside the band."""
-    members = [{"stiction": 1.5, "load_friction": 0.3}] * 7 + [{"stiction": 1.5, "load_friction": 0.45}]
+    members = ([{"stiction": 1.5, "load_friction": 0.3, "observer_gain": 340.0}] * 7
+               + [{"stiction": 1.5, "load_friction": 0.45, "observer_gain": 340.0}])
     per_member = [[2.8], [2.85], [2.9], [2.9], [2.95], [3.0], [3.1], [4.5]]
     text = validate.report(_fake(1.0, lag_within=True, stalled=0, members=members, per_member=per_member))
     assert "members' means span 2.80-4.50 deg" in text

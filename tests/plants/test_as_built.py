@@ -43,7 +43,7 @@ FRICTIONLESS = FrictionParams(viscous=0.0, coulomb_poly=(0.0,), stiction=0.0)
 CONSTANT_SUPPLY = SupplyLineParams()  # the thesis's P_s = P_0
 THESIS_FRICTION = FrictionParams(stiction=0.0)  # eq. 4.5.5 with eq. 4.5.7
 VALUES = {"stiction": 1.5, "air_fraction": 0.01, "ccw_coulomb_scale": 1.1,
-          "leak_conductance": 1e-14, "load_friction": 0.3, "observer_gain": 100.0}
+          "leak_conductance": 1e-14, "load_friction": 0.3, "observer_gain": 300.0}
 
 
 def eq_4_5_7(y: float) -> float:
@@ -461,19 +461,23 @@ def test_default_substeps_match_a_fine_step_reference():
     assert rms_pa < 0.1e3 and rms_pb < 0.1e3
 
 
-@pytest.mark.slow  # over ~2.5 s on 2 cores
+@pytest.mark.slow  # about 15 s on 2 cores
 @pytest.mark.parametrize("controller", ["ffpva", "smc"])
 def test_closed_loop_tracking_is_converged_in_the_substeps(controller):
     """T3 (no stop at the end, where stick-slip makes T1's ending sensitive to anything): the default
-    sub-steps give the mean RMSE over the thesis's five runs of 2000 per tick within 2 %.
+    sub-steps give the mean RMSE over twenty runs of 2000 per tick within 2 %.
 
-    Compared as an ensemble, as the thesis compares runs: a single closed-loop run is chaotic at its
-    stick/slip and dead-zone events, so a 1e-6 deg difference early on can flip one of them seconds
-    later. Measured on the committed preset (fifth of 2026-11-23, 100 sub-steps): single runs differ by up
-    to 2.9 % (FF + PVA) and 4.9 % (sliding mode), the five-run means by 0.3 % and 1.1 %."""
+    Compared as an ensemble: a single closed-loop run is chaotic at its stick/slip and dead-zone events,
+    so a 1e-6 deg difference early on can flip one of them seconds later. Measured on the fifth preset
+    (2026-11-23, 100 sub-steps): single runs differ by up to 2.9 % (FF + PVA) and 4.9 % (sliding mode),
+    the five-run means by 0.3 % and 1.1 %. **Changed after a failure** (2026-11-25): on the eighth refit
+    the five-run means of seeds 0-4 differ by 1.8 % and 2.4 %, while the twenty-run means differ by
+    0.4 % (FF + PVA, 2.228 against 2.238 deg) and 0.5 % (sliding mode, 2.299 against 2.311), and at
+    100 / 400 / 2000 sub-steps the five-run groups of seeds 0-19 scatter by 2-4 % each: five runs
+    measure the seeds' scatter, not the step; so the test now takes twenty."""
     plant = as_built_plant()
     default, fine = (np.mean([r.metrics.rmse for r in run_many([Scenario(controller, 3, plant=p, seed=seed)
-                                                                 for seed in range(5)])])
+                                                                 for seed in range(20)])])
                      for p in (plant, with_substeps(plant, 2000)))
     assert default == pytest.approx(fine, rel=0.02)
 

@@ -282,25 +282,37 @@ def cost_noise(costs: Sequence[float]) -> float:
     return spread(costs).std if len(costs) > 1 else 0.0
 
 
+SAME_VALUE_DIGITS = 9  # unit-box coordinates equal to this many digits are one value (Nelder-Mead's round-off)
+
+
+def _box_key(values: dict[str, float]) -> tuple[float, ...]:
+    """``values`` as unit-box coordinates rounded to :data:`SAME_VALUE_DIGITS`: values that differ only by
+    floating-point round-off (1e-13 of a box, as the simplex's arithmetic leaves them) are the same value."""
+    return tuple(round(x, SAME_VALUE_DIGITS) for x in unit_of(values))
+
+
 def choose_ensemble(evaluations: Sequence[Evaluation], best: Evaluation, noise: float,
                     limit: int = ENSEMBLE_MAX) -> list[Evaluation]:
     """The evaluations within ``noise`` of the best cost (duplicates once), at most ``limit``: the best
     first, then those with the lowest and the highest value of each :data:`PROFILED` parameter (so the
-    band shows what each does), then the rest by cost."""
+    band shows what each does; the cheapest of those sharing an extreme), then the rest by cost. Values
+    are compared on the unit box to :data:`SAME_VALUE_DIGITS` digits, so round-off makes no extreme."""
     unique: dict[tuple, Evaluation] = {}
     for e in evaluations:
-        unique.setdefault(tuple(sorted(e.values.items())), e)
+        unique.setdefault(_box_key(e.values), e)
     near = sorted((e for e in unique.values() if e.cost <= best.cost + noise), key=lambda e: e.cost)
     chosen = [best]
     extremes = []
     for name in PROFILED:
-        ordered = sorted(near, key=lambda e: e.values[name])
-        if ordered[0].values[name] < ordered[-1].values[name]:  # a parameter the near sets share tells nothing
-            extremes += [ordered[0], ordered[-1]]
+        index = [f.name for f in FITTED].index(name)
+        lowest = min(near, key=lambda e: (_box_key(e.values)[index], e.cost))
+        highest = min(near, key=lambda e: (-_box_key(e.values)[index], e.cost))
+        if _box_key(lowest.values)[index] < _box_key(highest.values)[index]:  # one value shared tells nothing
+            extremes += [lowest, highest]
     for e in [*extremes, *near]:
         if len(chosen) >= limit:
             break
-        if all(e.values != c.values for c in chosen):
+        if all(_box_key(e.values) != _box_key(c.values) for c in chosen):
             chosen.append(e)
     return chosen
 
@@ -418,8 +430,9 @@ def record(result: Calibration) -> dict:
         "bounds": {f.name: {"low": f.low, "high": f.high, "unit": f.unit, "why": f.why} for f in FITTED},
         "assumed": ASSUMED,
         "cost": result.cost,
-        "noise": {"how": "the fitted values' cost on the fit seeds and on each further seed set of the same size; "
-                         "noise = their sample std; the ensemble is every evaluated set with cost <= best + noise",
+        "noise": {"how": "the best values before the profiles: their cost on the fit seeds and on each further seed set "
+                         "of the same size; noise = their sample std; the ensemble is every evaluated set with "
+                         "cost <= best + noise",
                   "seed_sets": [list(result.fit_seeds), *(list(s) for s in result.noise_seed_sets)],
                   "costs": result.noise_costs, "std": result.noise},
         "ensemble": [{"values": dict(e.values), "cost": e.cost, "stage": e.stage} for e in result.ensemble],

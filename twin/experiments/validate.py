@@ -417,7 +417,8 @@ def report(v: Validation) -> str:
               "range of the members' five-run means (with eight members its ends are interpolated, so the lowest and the highest member are listed beside it); `stalled` counts the members' runs whose error passed "
               f"{STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). Breakaway of the members (N): "
               + ", ".join(f"{m['stiction']:.2f}" for m in d["members"]) + "; their load friction (N/N): "
-              + ", ".join(f"{m['load_friction']:.2f}" for m in d["members"]) + ".", "",
+              + ", ".join(f"{m['load_friction']:.2f}" for m in d["members"]) + "; their observer gain (1/s): "
+              + ", ".join(f"{m['observer_gain']:.0f}" for m in d["members"]) + ".", "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | members (lowest-highest) | stalled |",
               "|---|---|---|---|---|---|---|---|---|"]
     for r, means in zip(v.prediction, member_means(d), strict=True):

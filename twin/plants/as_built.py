@@ -104,8 +104,8 @@ ASSUMED = {
     "stiction_map": f"scatter {STICTION_SCATTER} N about the fitted breakaway, knots 1 mm apart, one map per run "
                     "(drawn from the run's seed)",
     "supply_line": "60 Hz, damping ratio 0.3, 2e-13 m^3/Pa at the valve block: a hose ringing near the 62.5 Hz "
-                   "PWM as §3 describes, sagging ~10 kPa at full flow; a trial fit of the frequency (2026-11-25, "
-                   "not installed) found 55 Hz best and 45-70 Hz within the cost's noise",
+                   "PWM as §3 describes, sagging ~10 kPa at full flow; a trial fit of the frequency on the seventh "
+                   "refit (2026-11-25, not installed) found 55 Hz best and 45-70 Hz within the cost's noise",
 }
 
 
