@@ -282,6 +282,7 @@ def cost_noise(costs: Sequence[float]) -> float:
     return spread(costs).std if len(costs) > 1 else 0.0
 
 
+FITTED_INDEX = {f.name: i for i, f in enumerate(FITTED)}  # a fitted parameter's place in the unit box
 SAME_VALUE_DIGITS = 9  # unit-box coordinates equal to this many digits are one value (Nelder-Mead's round-off)
 
 
@@ -297,24 +298,23 @@ def choose_ensemble(evaluations: Sequence[Evaluation], best: Evaluation, noise: 
     first, then those with the lowest and the highest value of each :data:`PROFILED` parameter (so the
     band shows what each does; the cheapest of those sharing an extreme), then the rest by cost. Values
     are compared on the unit box to :data:`SAME_VALUE_DIGITS` digits, so round-off makes no extreme."""
-    unique: dict[tuple, Evaluation] = {}
+    unique: dict[tuple, Evaluation] = {}  # unit-box key -> the first evaluation there
     for e in evaluations:
         unique.setdefault(_box_key(e.values), e)
-    near = sorted((e for e in unique.values() if e.cost <= best.cost + noise), key=lambda e: e.cost)
-    chosen = [best]
+    near = sorted(((key, e) for key, e in unique.items() if e.cost <= best.cost + noise), key=lambda ke: ke[1].cost)
+    chosen = {_box_key(best.values): best}
     extremes = []
     for name in PROFILED:
-        index = [f.name for f in FITTED].index(name)
-        lowest = min(near, key=lambda e: (_box_key(e.values)[index], e.cost))
-        highest = min(near, key=lambda e: (-_box_key(e.values)[index], e.cost))
-        if _box_key(lowest.values)[index] < _box_key(highest.values)[index]:  # one value shared tells nothing
+        i = FITTED_INDEX[name]
+        lowest = min(near, key=lambda ke: (ke[0][i], ke[1].cost))
+        highest = min(near, key=lambda ke: (-ke[0][i], ke[1].cost))
+        if lowest[0][i] < highest[0][i]:  # one value shared tells nothing
             extremes += [lowest, highest]
-    for e in [*extremes, *near]:
+    for key, e in [*extremes, *near]:
         if len(chosen) >= limit:
             break
-        if all(_box_key(e.values) != _box_key(c.values) for c in chosen):
-            chosen.append(e)
-    return chosen
+        chosen.setdefault(key, e)
+    return list(chosen.values())
 
 
 class _BudgetSpent(Exception):
@@ -382,7 +382,7 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
             report(noise_costs[-1], seen[best_key][0].values)
         stage = "profile"
         for name in PROFILED:  # each about the best of all so far (the first profile may move it)
-            index, centre = [f.name for f in FITTED].index(name), lowest()
+            index, centre = FITTED_INDEX[name], lowest()
             for x in np.linspace(0.0, 1.0, profile_points):
                 objective([x if i == index else centre[i] for i in range(len(FITTED))])
         # A profile point may beat the simplex (the cost is flat along the breakaway, within the noise):

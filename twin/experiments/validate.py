@@ -166,12 +166,12 @@ def sliding_mode_parts(committed: dict[str, float]) -> dict:
     from twin.sim.simulation import simulate
 
     plant = as_built_plant(committed)
+    thesis = controllers.make_controller("smc", nominal=nominal_model(plant), gain_set=plant.gain_set,
+                                         tick=plant.timestep)
+    watch = _SwitchingWatch(thesis)  # simulate resets both for each batch
+    bare = dataclasses.replace(thesis, gains=dataclasses.replace(thesis.gains, switching_amplitude=0.0))
     out: dict = {"dead_zone_pct": emergent_dead_zone(), "trajectories": {}}
     for t in sorted(key[1] for key in calibrate.EXPERIMENT_CELLS if key[0] == "smc"):
-        thesis = controllers.make_controller("smc", nominal=nominal_model(plant), gain_set=plant.gain_set,
-                                             tick=plant.timestep)
-        watch = _SwitchingWatch(thesis)
-        bare = dataclasses.replace(thesis, gains=dataclasses.replace(thesis.gains, switching_amplitude=0.0))
         scenarios = [Scenario("smc", t, plant=plant, seed=s) for s in SEEDS] * 2
         results = simulate(scenarios, controllers=[watch] * len(SEEDS) + [bare] * len(SEEDS))
         rmse = [math.degrees(r.metrics.rmse) for r in results]
