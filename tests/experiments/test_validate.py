@@ -170,3 +170,106 @@ def test_sliding_mode_without_its_switching_term_is_ff_pva_at_its_gain_without_c
     for t, part in parts["trajectories"].items():
         assert 0.5 < part["switching_rms_pct"] < 20.0, t
         assert part["without_switching_deg"] > part["as_run_deg"], t  # the term is all that lifts it
+
+
+def _pulse_length(duty: float, period_ticks: int) -> int:
+    """Ticks the discharge coil is on in a period for a held duty: the valve bank's rule, written out again."""
+    return int(round(abs(duty) / 100.0 * period_ticks))
+
+
+def test_opening_command_is_the_shortest_whole_tick_pulse_the_solenoid_valve_opens_on():
+    """The held duty the closed form takes as the valve's threshold, against the physical valve itself: a pulse
+    of that many 1 ms ticks passes water, one tick less does not."""
+    import numpy as np
+
+    from twin.experiments.studies.valve import NOMINAL_RIG, emergent_dead_zone
+    from twin.physics import solenoid
+    from twin.physics.params import NOMINAL_PARAMS
+
+    s = NOMINAL_PARAMS.valves.solenoid
+    ticks, per_tick = 16, int(round(1e-3 / s.step))
+    opening = validate.opening_command(emergent_dead_zone(), ticks)
+    assert opening == pytest.approx(28.125)  # 26 % dead zone: five ticks, realised from 4.5 / 16
+    n = _pulse_length(opening + 1e-6, ticks)  # 4.5 ticks is the edge (rounded half to even: 4)
+    assert n == 5 and _pulse_length(opening - 1e-6, ticks) == n - 1
+
+    def flows(pulse_ticks: int) -> bool:
+        coil = np.zeros(ticks * per_tick)
+        coil[:pulse_ticks * per_tick] = 1.0
+        states, _ = solenoid.simulate(s, coil, h=s.step, periods=3, inertance_time=NOMINAL_RIG.inertance_time)
+        return bool(states[:, 3].max() > 0.0)
+
+    assert flows(n) and not flows(n - 1)
+
+
+@pytest.mark.parametrize("name", ["pva", "ffpva", "smc"])
+def test_opening_lag_is_where_each_law_first_commands_a_pulse_that_opens_the_valve(name):
+    """The closed form against the controllers' own code: with the reference moving at T2's 10 mm/s and the joint
+    at rest behind it, an error a hair under the lag gives a command whose pulse is too short to open the valve, a hair over
+    it one that opens it (the first update of a period, as sliding mode holds u_FF+PVA from it)."""
+    import numpy as np
+
+    import controllers
+    from twin.envs.runner import nominal_model
+    from twin.physics.trajectories import RAMP_SPEED
+    from twin.plants.as_built import as_built_plant
+    from twin.sim.control import Measurement, Setpoint
+
+    plant = as_built_plant()
+    nominal = nominal_model(plant)
+    ticks = 16
+    opening = validate.opening_command(26.0, ticks)
+    law = controllers.make_controller(name, nominal=nominal, gain_set=plant.gain_set, tick=plant.timestep)
+    for y in (3e-3, 7e-3, 11e-3):
+        lag = validate.opening_lag(law, nominal, y, RAMP_SPEED, opening)
+        assert 0.1e-3 < lag < 0.4e-3, (name, y, lag)  # 1-5 deg: a lag of the order the runs show
+
+        def pulse(error: float, y: float = y) -> int:
+            law.reset(1)
+            u = law.update(0.0, Measurement(position=np.array([y - error]), velocity=np.zeros(1),
+                                            acceleration=np.zeros(1), supply_pressure=np.array([300e3])),
+                           Setpoint(position=np.array([y]), velocity=np.array([RAMP_SPEED]),
+                                    acceleration=np.zeros(1)))
+            assert u[0] >= 0.0
+            return _pulse_length(float(u[0]), ticks)
+
+        assert pulse(lag - 1e-8) < 5 <= pulse(lag + 1e-8), (name, y)
+
+
+def test_pulse_statistics_of_a_made_up_run():
+    """Three openings in 0.1 s; the advance from each opening to the next (the last to the run's end) and the
+    error when each opened."""
+    import math
+
+    import numpy as np
+
+    time = np.arange(100) * 1e-3
+    opened = np.zeros(100, dtype=bool)
+    opened[[10, 11, 12, 40, 41, 70]] = True
+    scored = np.radians(np.select([np.arange(100) < 20, np.arange(100) < 50, np.arange(100) < 80], [1.0, 3.0, 6.0],
+                                  7.0))
+    desired = np.radians(np.full(100, 5.0))
+    stats = validate.pulse_statistics(time, desired, scored, opened)
+    assert stats["openings_per_s"] == pytest.approx(30.0)
+    assert stats["advance_deg"] == pytest.approx([2.0, 3.0, 1.0])
+    assert stats["error_at_opening_deg"] == pytest.approx([4.0, 2.0, 1.0])
+    assert math.isclose(sum(stats["advance_deg"]), 6.0)
+
+
+def test_report_shows_the_pulse_cycle_and_each_laws_opening_lag():
+    v = _fake(1.0, lag_within=True, stalled=0)
+    assert "Slow motion in pulses" not in validate.report(v)  # not run: no line, no table
+    run = {"rmse_deg": 2.3, "openings_per_s": 16.0, "advance_deg": 7.5, "error_at_opening_deg": 4.1}
+    v.pulses = {"opening_pct": 28.125, "feedforward_pct": (7.9, 12.6),
+                "lag_deg": {"pva": 3.61, "ffpva": 2.65, "smc": 2.79},
+                "runs": {(n, t): dict(run, rmse_deg=r) for n, t, r in (
+                    ("pva", 2, 2.75), ("pva", 3, 2.93), ("ffpva", 2, 2.26), ("ffpva", 3, 2.15), ("smc", 2, 2.33),
+                    ("smc", 3, 2.24))}}
+    text = validate.report(v)
+    assert "asks for 8-13 % of duty, inside the valve's dead zone" in text
+    assert "FF + PVA 2.65 deg, sliding mode 2.79 deg, PVA + DZC 3.61 deg" in text
+    assert "The twin's RMSE on T2 and T3 follows that order." in text
+    assert "the rig's sliding mode tracked at 0.75 of its FF + PVA on T2" in text  # the fake has no measured T3 cells
+    assert "| sliding mode | 2 | 2.33 | 16.0 | 7.50 | 4.10 | 2.79 |" in text
+    v.pulses["runs"][("smc", 3)]["rmse_deg"] = 2.0
+    assert "The twin's RMSE on T2 follows that order (not on the other)." in validate.report(v)
