@@ -172,68 +172,82 @@ def test_sliding_mode_without_its_switching_term_is_ff_pva_at_its_gain_without_c
         assert part["without_switching_deg"] > part["as_run_deg"], t  # the term is all that lifts it
 
 
-def _pulse_length(duty: float, period_ticks: int) -> int:
-    """Ticks the discharge coil is on in a period for a held duty: the valve bank's rule, written out again."""
-    return int(round(abs(duty) / 100.0 * period_ticks))
-
-
-def test_opening_command_is_the_shortest_whole_tick_pulse_the_solenoid_valve_opens_on():
-    """The held duty the closed form takes as the valve's threshold, against the physical valve itself: a pulse
-    of that many 1 ms ticks passes water, one tick less does not."""
-    import numpy as np
-
-    from twin.experiments.studies.valve import NOMINAL_RIG, emergent_dead_zone
+def test_opening_ticks_is_the_shortest_whole_tick_pulse_that_passes_water():
+    """Against the valve test replica's own measure (the period-averaged flow of a PWM duty, water column
+    included): a duty of that many 1 ms ticks passes water, one tick less passes none; 26 % dead zone, 5 ticks."""
+    from twin.experiments.studies.valve import NOMINAL_RIG
     from twin.physics import solenoid
     from twin.physics.params import NOMINAL_PARAMS
 
     s = NOMINAL_PARAMS.valves.solenoid
-    ticks, per_tick = 16, int(round(1e-3 / s.step))
-    opening = validate.opening_command(emergent_dead_zone(), ticks)
-    assert opening == pytest.approx(28.125)  # 26 % dead zone: five ticks, realised from 4.5 / 16
-    n = _pulse_length(opening + 1e-6, ticks)  # 4.5 ticks is the edge (rounded half to even: 4)
-    assert n == 5 and _pulse_length(opening - 1e-6, ticks) == n - 1
+    n = validate.opening_ticks(s, 16, 1e-3)
+    assert n == 5
 
-    def flows(pulse_ticks: int) -> bool:
-        coil = np.zeros(ticks * per_tick)
-        coil[:pulse_ticks * per_tick] = 1.0
-        states, _ = solenoid.simulate(s, coil, h=s.step, periods=3, inertance_time=NOMINAL_RIG.inertance_time)
-        return bool(states[:, 3].max() > 0.0)
+    def flow(ticks: int) -> float:
+        return solenoid.mean_flow_fraction(s, ticks / 16 * 100.0, period=16e-3, h=s.step,
+                                           inertance_time=NOMINAL_RIG.inertance_time)
 
-    assert flows(n) and not flows(n - 1)
+    assert flow(n) > 0.0 and flow(n - 1) == 0.0
 
 
 @pytest.mark.parametrize("name", ["pva", "ffpva", "smc"])
 def test_opening_lag_is_where_each_law_first_commands_a_pulse_that_opens_the_valve(name):
-    """The closed form against the controllers' own code: with the reference moving at T2's 10 mm/s and the joint
-    at rest behind it, an error a hair under the lag gives a command whose pulse is too short to open the valve, a hair over
-    it one that opens it (the first update of a period, as sliding mode holds u_FF+PVA from it)."""
+    """The closed form against the controllers' own code and the valve bank's coil rule, stepped tick by tick
+    through one PWM period: the reference moves on at T2's 10 mm/s, the joint stays at rest; an error a hair
+    under the lag at the period's start gives a discharge pulse too short to open the valve, a hair over it one
+    that opens it."""
     import numpy as np
 
     import controllers
     from twin.envs.runner import nominal_model
+    from twin.physics.ticks import whole_ticks
     from twin.physics.trajectories import RAMP_SPEED
+    from twin.physics.valves import _solenoid_coils
     from twin.plants.as_built import as_built_plant
     from twin.sim.control import Measurement, Setpoint
 
     plant = as_built_plant()
     nominal = nominal_model(plant)
-    ticks = 16
-    opening = validate.opening_command(26.0, ticks)
-    law = controllers.make_controller(name, nominal=nominal, gain_set=plant.gain_set, tick=plant.timestep)
+    h = plant.timestep
+    ticks = whole_ticks(plant.params.valves.pwm_period, h)
+    n_open = validate.opening_ticks(plant.params.valves.solenoid, ticks, h)
+    law = controllers.make_controller(name, nominal=nominal, gain_set=plant.gain_set, tick=h)
+    every = whole_ticks(law.period, h)
     for y in (3e-3, 7e-3, 11e-3):
-        lag = validate.opening_lag(law, nominal, y, RAMP_SPEED, opening)
+        lag = validate.opening_lag(law, nominal, y, RAMP_SPEED, ticks_to_open=n_open, period_ticks=ticks, tick=h)
         assert 0.1e-3 < lag < 0.4e-3, (name, y, lag)  # 1-5 deg: a lag of the order the runs show
 
         def pulse(error: float, y: float = y) -> int:
+            """Ticks the discharge coil is on from the period's start."""
             law.reset(1)
-            u = law.update(0.0, Measurement(position=np.array([y - error]), velocity=np.zeros(1),
-                                            acceleration=np.zeros(1), supply_pressure=np.array([300e3])),
-                           Setpoint(position=np.array([y]), velocity=np.array([RAMP_SPEED]),
-                                    acceleration=np.zeros(1)))
-            assert u[0] >= 0.0
-            return _pulse_length(float(u[0]), ticks)
+            joint = y - error
+            on, u = 0, np.zeros(1)
+            for k in range(ticks):
+                if k % every == 0:
+                    u = law.update(k * h, Measurement(position=np.array([joint]), velocity=np.zeros(1),
+                                                      acceleration=np.zeros(1), supply_pressure=np.array([300e3])),
+                                   Setpoint(position=np.array([y + k * h * RAMP_SPEED]),
+                                            velocity=np.array([RAMP_SPEED]), acceleration=np.zeros(1)))
+                coil = np.zeros((1, 4))
+                _solenoid_coils(u, k, ticks, ticks, coil)
+                if coil[0, 3] != 1.0:
+                    break
+                on += 1
+            return on
 
-        assert pulse(lag - 1e-8) < 5 <= pulse(lag + 1e-8), (name, y)
+        assert pulse(lag - 1e-8) < n_open <= pulse(lag + 1e-8), (name, y)
+
+
+def test_opening_lag_refuses_a_reference_that_does_not_move_forwards():
+    import controllers
+    from twin.envs.runner import nominal_model
+    from twin.plants.as_built import as_built_plant
+
+    plant = as_built_plant()
+    nominal = nominal_model(plant)
+    law = controllers.make_controller("smc", nominal=nominal, gain_set=plant.gain_set, tick=plant.timestep)
+    with pytest.raises(ValueError, match="forwards"):
+        validate.opening_lag(law, nominal, 7e-3, -0.01, ticks_to_open=5, period_ticks=16, tick=1e-3)
 
 
 def test_pulse_statistics_of_a_made_up_run():
@@ -259,17 +273,23 @@ def test_pulse_statistics_of_a_made_up_run():
 def test_report_shows_the_pulse_cycle_and_each_laws_opening_lag():
     v = _fake(1.0, lag_within=True, stalled=0)
     assert "Slow motion in pulses" not in validate.report(v)  # not run: no line, no table
-    run = {"rmse_deg": 2.3, "openings_per_s": 16.0, "advance_deg": 7.5, "error_at_opening_deg": 4.1}
-    v.pulses = {"opening_pct": 28.125, "feedforward_pct": (7.9, 12.6),
-                "lag_deg": {"pva": 3.61, "ffpva": 2.65, "smc": 2.79},
+    run = {"rmse_deg": 2.3, "rmse_std_deg": 0.1, "openings_per_s": 16.0, "advance_deg": 7.5,
+           "error_at_opening_deg": 4.1}
+    v.pulses = {"opening_pct": 28.125, "feedforward_pct": (7.9, 12.6), "period_advance_deg": 1.92,
+                "opening_delay_ms": 5.0, "phi": 0.3, "lag_deg": {"pva": 3.61, "ffpva": 2.62, "smc": 2.67},
                 "runs": {(n, t): dict(run, rmse_deg=r) for n, t, r in (
                     ("pva", 2, 2.75), ("pva", 3, 2.93), ("ffpva", 2, 2.26), ("ffpva", 3, 2.15), ("smc", 2, 2.33),
                     ("smc", 3, 2.24))}}
     text = validate.report(v)
-    assert "asks for 8-13 % of duty, inside the valve's dead zone" in text
-    assert "FF + PVA 2.65 deg, sliding mode 2.79 deg, PVA + DZC 3.61 deg" in text
-    assert "The twin's RMSE on T2 and T3 follows that order." in text
-    assert "the rig's sliding mode tracked at 0.75 of its FF + PVA on T2" in text  # the fake has no measured T3 cells
-    assert "| sliding mode | 2 | 2.33 | 16.0 | 7.50 | 4.10 | 2.79 |" in text
-    v.pulses["runs"][("smc", 3)]["rmse_deg"] = 2.0
-    assert "The twin's RMSE on T2 follows that order (not on the other)." in validate.report(v)
+    assert "asks for 8-13 % of duty, inside the dead zone (a held command opens the valve from 28.1 %)" in text
+    assert "FF + PVA 2.62 deg, sliding mode 2.67 deg, PVA + DZC 3.61 deg." in text
+    assert "Sliding mode's lag is 1.02 of FF + PVA's" in text and "phi = 0.3 m/s" in text
+    assert "T2: 2.26 ± 0.10 and 2.33 ± 0.10" in text
+    assert "The rig's sliding mode tracked at 0.75 of its FF + PVA there." in text  # the fake has no measured T3
+    assert "the reference moves 1.9 deg a period) and the 5 ms the valve takes to open" in text
+    assert "| sliding mode | 2 | 2.33 | 16.0 | 7.50 | 4.10 | 2.67 |" in text
+    v.pulses["lag_deg"]["smc"] = 1.5  # a clearly smaller lag: no claim about the rig
+    text = validate.report(v)
+    assert "The rig's sliding mode" not in text and "FF + PVA and sliding mode on the twin: T2: 2.26" in text
+    v.pulses["feedforward_pct"] = (20.0, 40.0)
+    assert "partly above the 28.1 % that opens the valve" in validate.report(v)
