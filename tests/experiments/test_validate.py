@@ -61,7 +61,8 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
         assert int(r["stalled_runs"]) >= 0 and math.isfinite(float(r["twin_mean"]))
     report = (out / "validation.md").read_text()
     assert "## Why, as far as the twin shows" in report and "## Prediction: Chapter 6 T3 (blind)" in report
-    for name in ("validation.png", "prediction.png"):
+    assert "![T2's first run" in report
+    for name in ("validation.png", "prediction.png", "pulses.png"):
         assert (out / name).read_bytes().startswith(b"\x89PNG")
     assert not list(out.glob("*.tmp*"))
     assert "wrote" in proc.stdout and "prediction.csv" in proc.stdout
@@ -287,7 +288,7 @@ def test_report_shows_the_pulse_cycle_and_each_laws_opening_lag():
     assert "T2: 2.26 ± 0.10 and 2.33 ± 0.10" in text
     assert "The rig's sliding mode tracked at 0.75 of its FF + PVA there." in text  # the fake has no measured T3
     assert "the reference moves 1.9 deg a period) and the 5 ms the valve takes to open" in text
-    assert "| sliding mode | 2 | 2.33 | 16.0 | 7.50 | 4.10 | 2.67 |" in text
+    assert "| sliding mode | 2 | 2.33 | 16.0 | 7.50 | 4.10 | 2.67 |" in text and "(pulses.png)" in text
     v.pulses["lag_deg"]["smc"] = 1.5  # a clearly smaller lag: no claim about the rig
     text = validate.report(v)
     assert "The rig's sliding mode" not in text and "FF + PVA and sliding mode on the twin: T2: 2.26" in text

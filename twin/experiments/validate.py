@@ -264,7 +264,7 @@ def pulse_statistics(time: np.ndarray, desired: np.ndarray, scored: np.ndarray, 
 def pulse_cycle(committed: dict[str, float]) -> dict:
     """How the as-built controllers move the joint on the slow trajectories (Chapter 5, horizontal, no payload,
     seeds 0-4): per controller and trajectory the runs' mean RMSE, their openings per second and the medians
-    of :func:`pulse_statistics`; per controller the closed-form :func:`opening_lag` on T2 (deg, the median
+    of :func:`pulse_statistics` (and T2's first run, for :func:`figure_pulses`); per controller the closed-form :func:`opening_lag` on T2 (deg, the median
     over T2's reference); T2's feed-forward duty (%, lowest and highest), the command that opens the valve
     (%), how far T2's reference moves in a PWM period (deg), the valve's opening delay (ms) and sliding mode's
     phi (m/s)."""
@@ -302,11 +302,16 @@ def pulse_cycle(committed: dict[str, float]) -> dict:
     keys = [(name, t) for name in names for t in SLOW_TRAJECTORIES]
     scenarios = [Scenario(name, t, plant=plant, seed=s) for name, t in keys for s in SEEDS]
     results = run_many(scenarios)
+    out["example"] = {}  # controller -> T2's first run: time (s), error (deg), discharge open (bool), (T,) each
     for k, key in enumerate(keys):
         runs = results[k * len(SEEDS):(k + 1) * len(SEEDS)]
-        stats = [pulse_statistics(r.trace.time, r.trace.desired_angle, r.trace.measured_position / radius
-                                  if plant.metrics_on_sensor else r.trace.angle,
-                                  r.trace.valve_open[:, 1] | r.trace.valve_open[:, 3]) for r in runs]
+        scored = [r.trace.measured_position / radius if plant.metrics_on_sensor else r.trace.angle for r in runs]
+        opened = [r.trace.valve_open[:, 1] | r.trace.valve_open[:, 3] for r in runs]
+        stats = [pulse_statistics(r.trace.time, r.trace.desired_angle, y, o)
+                 for r, y, o in zip(runs, scored, opened, strict=True)]
+        if key[1] == 2:
+            out["example"][key[0]] = (runs[0].trace.time, np.degrees(runs[0].trace.desired_angle - scored[0]),
+                                      opened[0])
         out["runs"][key] = {
             "rmse_deg": spread([math.degrees(r.metrics.rmse) for r in runs]).mean,
             "rmse_std_deg": spread([math.degrees(r.metrics.rmse) for r in runs]).std,
@@ -566,7 +571,7 @@ def report(v: Validation) -> str:
             lines.append(f"| {CONTROLLER_LABELS[name]} | {t} | {run['rmse_deg']:.2f} | {run['openings_per_s']:.1f} | "
                          f"{run['advance_deg']:.2f} | {run['error_at_opening_deg']:.2f} | "
                          f"{v.pulses['lag_deg'][name]:.2f} |")
-        lines.append("")
+        lines += ["", "![T2's first run: the error, each opening of a discharge valve and the law's lag](pulses.png)", ""]
 
     def table(title: str, members: list[dict], note: str) -> None:
         if not members:
@@ -649,6 +654,28 @@ def figure_validation(rows: Sequence[dict], path: pathlib.Path) -> None:
     plt.close(fig)
 
 
+def figure_pulses(v: Validation, path: pathlib.Path) -> None:
+    """T2's first run per controller: the error, the discharge valve's openings and the law's closed-form lag."""
+    example = (v.pulses or {}).get("example") or {}
+    fig, axes = plt.subplots(len(example) or 1, 1, figsize=(10, 1.0 + 1.9 * max(len(example), 1)), sharex=True,
+                             sharey=True, constrained_layout=True, squeeze=False)
+    for ax, (name, (time, error, opened)) in zip(axes[:, 0], example.items(), strict=False):
+        ax.plot(time, error, color="tab:blue", lw=1.0, label="error (deg)")
+        starts = np.flatnonzero(np.diff(np.concatenate(([False], opened)).astype(int)) == 1)
+        ax.vlines(time[starts], 0.0, error[starts], color="tab:red", lw=1.0, label="a discharge valve opens")
+        ax.axhline(v.pulses["lag_deg"][name], color="k", ls="--", lw=0.8,
+                   label=f"closed-form lag {v.pulses['lag_deg'][name]:.2f} deg")
+        ax.axhline(0.0, color="0.6", lw=0.6)
+        ax.set_title(f"{CONTROLLER_LABELS[name]}, T2 (seed {SEEDS[0]}): RMSE "
+                     f"{math.sqrt(float(np.mean(np.square(error)))):.2f} deg", fontsize=9)
+        ax.set_ylabel("deg")
+        ax.legend(fontsize=7, loc="upper right", ncol=3)
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("time (s)")
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+
+
 def figure_prediction(v: Validation, path: pathlib.Path) -> None:
     """The T3 prediction: the committed preset's mean, each member's mean, the 10-90 % band."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharey=True, constrained_layout=True)
@@ -711,16 +738,17 @@ class ValidateExperiment(Experiment):
         return Outcome(rows=v.rows, answer=answer, failed=v.failed, detail=v)
 
     def outputs(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
-        """``validation.csv``, ``prediction.csv``, ``validation.md`` and its two figures (the CLI's
+        """``validation.csv``, ``prediction.csv``, ``validation.md`` and its three figures (the CLI's
         :meth:`publish` makes them all or nothing)."""
         v = outcome.detail
         paths = [out / "validation.csv", out / "prediction.csv", out / "validation.md", out / "validation.png",
-                 out / "prediction.png"]
+                 out / "prediction.png", out / "pulses.png"]
         write_csv(v.rows, VALIDATION_COLUMNS, paths[0])
         write_csv(v.prediction, PREDICTION_COLUMNS, paths[1])
         paths[2].write_text(report(v))
         figure_validation(v.rows, paths[3])
         figure_prediction(v, paths[4])
+        figure_pulses(v, paths[5])
         return paths
 
 
