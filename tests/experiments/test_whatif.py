@@ -152,7 +152,8 @@ def test_whatif_lift_cli_writes_sorted_rows_and_says_what_it_did_not_study(tmp_p
 
 @pytest.mark.parametrize("study, flag, value", [
     ("lift", "--pressures", "100,x"), ("lift", "--pressures", "900"), ("payload", "--payloads", "0,x"),
-    ("payload", "--payloads", "-5"), ("pwm", "--periods", "2.5")])
+    ("payload", "--payloads", "-5"), ("pwm", "--periods", "2.5"), ("smc-phi", "--phis", "0"),
+    ("smc-phi", "--phis", "0.2,x")])
 def test_whatif_rejects_a_bad_list_naming_its_flag_and_writes_nothing(tmp_path, capsys, study, flag, value):
     out = tmp_path / "never"
     assert main(["whatif", study, flag, value, "--out", str(out)]) == 2
@@ -193,3 +194,28 @@ def test_whatif_supply_writes_its_answer_and_refuses_a_plant_with_a_constant_sup
     never = tmp_path / "never"
     assert main(["whatif", "supply", "--plant", "thesis", "--out", str(never)]) == 2
     assert "holds its supply constant" in capsys.readouterr().err and not never.exists()
+
+
+def test_smc_phi_changes_phi_alone_and_reports_against_the_measurements():
+    """At the thesis's phi the what-if's sliding mode is the thesis's controller to the last bit, and its FF + PVA
+    the thesis's too (both against plain runs of the same seeds); a stronger switching term (smaller phi) opens the
+    valve at a smaller lag, as the closed form has it; the answer says where every measured cell is within 20 %."""
+    from twin.envs.runner import run_many
+    from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
+    from twin.experiments.whatifs.smc_phi import TRAJECTORIES, phi_study
+    from twin.sim.scenario import Scenario
+
+    outcome = phi_study(phis=(0.2,), seeds=1)
+    rows = outcome.rows
+    assert {(r["controller"], r["phi_m_s"]) for r in rows} == {("smc", 0.2), ("smc", 0.3), ("ffpva", None)}
+    assert len(rows) == 3 * len(TRAJECTORIES) and outcome.failed == 0
+    plain = run_many([Scenario(c, t, plant="as-built", seed=0) for c in ("smc", "ffpva") for t in TRAJECTORIES])
+    expected = {(r.scenario.controller, r.scenario.trajectory): math.degrees(r.metrics.rmse) for r in plain}
+    for r in rows:
+        assert r["measured_deg"] == THESIS_EXPERIMENT_RMSE_DEG[r["controller"]][r["trajectory"]][0]
+        assert r["ratio"] == pytest.approx(r["rmse_mean_deg"] / r["measured_deg"], rel=1e-12)
+        if r["phi_m_s"] in (0.3, None):
+            assert r["rmse_mean_deg"] == expected[(r["controller"], r["trajectory"])]
+    lag = {(r["controller"], r["phi_m_s"]): r["opening_lag_t2_deg"] for r in rows}
+    assert lag[("smc", 0.2)] < lag[("smc", 0.3)]
+    assert "the thesis's: 0.3 m/s" in outcome.answer and "A what-if only" in outcome.answer

@@ -249,6 +249,27 @@ def opening_lag(controller, nominal, position: float, speed: float, *, ticks_to_
     raise TypeError(f"no closed form for {type(controller).__name__}")
 
 
+def ramp_opening_lags(plant, nominal, laws: dict) -> dict:
+    """Per law in ``laws`` (name -> controller), the closed-form :func:`opening_lag` on T2 (deg, the median over
+    the ramp's reference) on ``plant``'s solenoid valve; also ``"opening_pct"``, the held command whose pulse
+    opens that valve, and ``"feedforward_pct"``, the ramp's feed-forward duty (lowest, highest)."""
+    from controllers.feedforward import feedforward_duty
+    from twin.physics.ticks import whole_ticks
+    from twin.physics.trajectories import RAMP_SPEED, trajectory
+
+    radius = plant.params.gears.spur_radius
+    period_ticks = whole_ticks(plant.params.valves.pwm_period, plant.timestep, what="PWM period")
+    n_open = opening_ticks(plant.params.valves.solenoid, period_ticks, plant.timestep)
+    ramp = trajectory(2, spur_radius=radius)
+    positions = ramp.sample(np.arange(0.0, ramp.duration, plant.timestep), radius).position
+    u_ff = feedforward_duty(nominal, positions, np.full(positions.shape, RAMP_SPEED), np.zeros(positions.shape))
+    lags = {name: math.degrees(float(np.median([
+        opening_lag(law, nominal, float(y), RAMP_SPEED, ticks_to_open=n_open, period_ticks=period_ticks,
+                    tick=plant.timestep) for y in positions])) / radius) for name, law in laws.items()}
+    return {"lag_deg": lags, "opening_pct": (n_open - 0.5) / period_ticks * 100.0,
+            "feedforward_pct": (float(u_ff.min()), float(u_ff.max()))}
+
+
 def pulse_statistics(time: np.ndarray, desired: np.ndarray, scored: np.ndarray, discharge_open: np.ndarray
                      ) -> dict:
     """One run's pulses: ``discharge_open`` (T,) bool, either discharge valve open; angles in rad. Returns the
@@ -269,10 +290,8 @@ def pulse_cycle(committed: dict[str, float]) -> dict:
     (%), how far T2's reference moves in a PWM period (deg), the valve's opening delay (ms) and sliding mode's
     phi (m/s)."""
     import controllers
-    from controllers.feedforward import feedforward_duty
     from twin.envs.runner import nominal_model, run_many
-    from twin.physics.ticks import whole_ticks
-    from twin.physics.trajectories import RAMP_SPEED, trajectory
+    from twin.physics.trajectories import RAMP_SPEED
     from twin.plants.as_built import as_built_plant
     from twin.sim.scenario import Scenario
 
@@ -280,25 +299,15 @@ def pulse_cycle(committed: dict[str, float]) -> dict:
     nominal = nominal_model(plant)
     radius = plant.params.gears.spur_radius
     valves = plant.params.valves
-    period_ticks = whole_ticks(valves.pwm_period, plant.timestep, what="PWM period")
-    n_open = opening_ticks(valves.solenoid, period_ticks, plant.timestep)
-    ramp = trajectory(2, spur_radius=radius)
-    positions = ramp.sample(np.arange(0.0, ramp.duration, plant.timestep), radius).position
-    u_ff = feedforward_duty(nominal, positions, np.full(positions.shape, RAMP_SPEED), np.zeros(positions.shape))
-    out: dict = {"opening_pct": (n_open - 0.5) / period_ticks * 100.0,
-                 "feedforward_pct": (float(u_ff.min()), float(u_ff.max())),
-                 "period_advance_deg": math.degrees(RAMP_SPEED * valves.pwm_period / radius),
-                 "opening_delay_ms": valves.opening_delay * 1e3,
-                 "lag_deg": {}, "runs": {}}
     names = [name for name in ("pva", "ffpva", "smc")
              if all((name, t, 0.0, "horizontal") in calibrate.EXPERIMENT_CELLS for t in SLOW_TRAJECTORIES)]
-    for name in names:
-        law = controllers.make_controller(name, nominal=nominal, gain_set=plant.gain_set, tick=plant.timestep)
-        lags = [opening_lag(law, nominal, float(y), RAMP_SPEED, ticks_to_open=n_open, period_ticks=period_ticks,
-                            tick=plant.timestep) for y in positions]
-        out["lag_deg"][name] = math.degrees(float(np.median(lags)) / radius)
-        if name == "smc":
-            out["phi"] = law.gains.boundary_layer
+    laws = {name: controllers.make_controller(name, nominal=nominal, gain_set=plant.gain_set, tick=plant.timestep)
+            for name in names}
+    out: dict = {**ramp_opening_lags(plant, nominal, laws),
+                 "period_advance_deg": math.degrees(RAMP_SPEED * valves.pwm_period / radius),
+                 "opening_delay_ms": valves.opening_delay * 1e3, "runs": {}}
+    if "smc" in laws:
+        out["phi"] = laws["smc"].gains.boundary_layer
     keys = [(name, t) for name in names for t in SLOW_TRAJECTORIES]
     scenarios = [Scenario(name, t, plant=plant, seed=s) for name, t in keys for s in SEEDS]
     results = run_many(scenarios)

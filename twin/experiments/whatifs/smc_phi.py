@@ -1,0 +1,152 @@
+"""``twin whatif smc-phi``: sliding mode against its boundary layer phi, on the Chapter 5 experiments.
+
+Sliding mode adds 100 % sat(sigma / phi) to FF + PVA every 1 ms (§6); the thesis ran it at phi = 0.3 m/s.
+On the as-built plant its switching term at that phi lifts the command past the valve's dead zone no
+sooner than FF + PVA's compensation does (``twin validate``'s pulse cycle), and the twin's sliding mode
+misses T2 and T3. This what-if asks how strong the term would have to be: sliding mode at each phi
+(T1-T4, horizontal, no payload, seeds 0..N-1), beside FF + PVA on the same seeds, the measured means and
+the closed-form lag at which the law opens the valve on T2. It answers a question; it changes nothing:
+phi stays the thesis's in every other command.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import math
+import pathlib
+from collections.abc import Sequence
+
+from twin.exceptions import InvalidScenario
+from twin.experiments.arguments import positive_int
+from twin.experiments.base import Experiment, Outcome
+from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
+from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
+from twin.sim.metrics import spread
+from viz.figures import finish_panels, plt
+
+COLUMNS = ("controller", "phi_m_s", "trajectory", "rmse_mean_deg", "rmse_std_deg", "measured_deg", "ratio",
+           "opening_lag_t2_deg")
+TRAJECTORIES = (1, 2, 3, 4)
+DEFAULT_PHIS = (0.1, 0.15, 0.2, 0.3)
+TOLERANCE = 0.20  # the issue's bar for a measured cell
+
+
+def parse_phis(text: str) -> tuple[float, ...]:
+    """``--phis``: boundary layers in m/s, comma-separated, each in (0, 10]; the plant's own phi is always run."""
+    try:
+        values = {float(part) for part in text.split(",") if part.strip()}
+    except ValueError:
+        raise InvalidScenario(f"--phis: numbers in m/s separated by commas, got {text!r}") from None
+    if not values or not all(math.isfinite(v) and 0 < v <= 10 for v in values):
+        raise InvalidScenario(f"--phis: each phi must be in (0, 10] m/s, got {text!r}")
+    return tuple(sorted(values))
+
+
+def phi_study(*, phis: Sequence[float], seeds: int = 10, plant_name: str = "as-built", bar=None) -> Outcome:
+    """Sliding mode at each phi and FF + PVA, T1-T4 on ``plant_name``, seeds 0..``seeds``-1, one batch."""
+    import controllers
+    from twin.envs.runner import nominal_model
+    from twin.experiments import validate
+    from twin.physics.valves import ValveModel
+    from twin.plants import plant
+    from twin.sim.scenario import Scenario
+    from twin.sim.simulation import simulate
+
+    base = plant(plant_name)
+    nominal = nominal_model(base)
+    thesis = controllers.make_controller("smc", nominal=nominal, gain_set=base.gain_set, tick=base.timestep)
+    phis = tuple(sorted(set(phis) | {thesis.gains.boundary_layer}))
+    laws = {("smc", phi): dataclasses.replace(thesis, gains=dataclasses.replace(thesis.gains, boundary_layer=phi))
+            for phi in phis}
+    laws[("ffpva", None)] = controllers.make_controller("ffpva", nominal=nominal, gain_set=base.gain_set,
+                                                        tick=base.timestep)
+    jobs = [(key, t, s) for key in laws for t in TRAJECTORIES for s in range(seeds)]
+    if bar is not None:
+        bar.reset(total=len(jobs))
+    results = simulate([Scenario(key[0], t, plant=base, seed=s) for key, t, s in jobs],
+                       controllers=[laws[key] for key, _, _ in jobs], progress=batch_progress(bar, len(jobs)))
+    lags = (validate.ramp_opening_lags(base, nominal, laws)["lag_deg"]
+            if base.valve_model is ValveModel.SOLENOID else {})  # no valve threshold to reach: no closed form
+    rows = []
+    for key in laws:
+        lag = lags.get(key, math.nan)
+        for t in TRAJECTORIES:
+            runs = [r for (k, tt, _), r in zip(jobs, results, strict=True) if k == key and tt == t]
+            s = spread([math.degrees(r.metrics.rmse) for r in runs])
+            measured = THESIS_EXPERIMENT_RMSE_DEG[key[0]][t][0]
+            rows.append(dict(zip(COLUMNS, (key[0], key[1], t, s.mean, s.std, measured, s.mean / measured, lag),
+                                 strict=True)))
+    failed = sum(bool(r.warnings) for r in results)
+    return Outcome(rows, answer(rows, phi=thesis.gains.boundary_layer, seeds=seeds, plant_name=plant_name),
+                   failed=failed, detail=thesis.gains.boundary_layer)
+
+
+def answer(rows: Sequence[dict], *, phi: float, seeds: int, plant_name: str) -> str:
+    ffpva = {r["trajectory"]: r["rmse_mean_deg"] for r in rows if r["controller"] == "ffpva"}
+    smc = [r for r in rows if r["controller"] == "smc"]
+    lines = [f"Sliding mode on {plant_name} against its boundary layer phi (the thesis's: {phi:g} m/s), T1-T4, "
+             f"seeds 0-{seeds - 1}; mean RMSE in deg, x measured, and the closed-form lag at which it opens the valve "
+             f"on T2. FF + PVA on the same seeds: " + " / ".join(f"{ffpva[t]:.2f}" for t in TRAJECTORIES)
+             + f" (lag {next(r['opening_lag_t2_deg'] for r in rows if r['controller'] == 'ffpva'):.2f} deg)."]
+    fitting = []
+    for value in sorted({r["phi_m_s"] for r in smc}, reverse=True):
+        group = sorted((r for r in smc if r["phi_m_s"] == value), key=lambda r: r["trajectory"])
+        within = sum(abs(r["ratio"] - 1) <= TOLERANCE for r in group)
+        ahead = sum(r["rmse_mean_deg"] < ffpva[r["trajectory"]] for r in group)
+        if within == len(group):
+            fitting.append(value)
+        lines.append(f"phi {value:g} m/s: " + " / ".join(f"{r['rmse_mean_deg']:.2f} (x{r['ratio']:.2f})" for r in group)
+                     + f"; within {TOLERANCE:.0%} on {within} of {len(group)}, ahead of FF + PVA on {ahead}; "
+                     f"lag {group[0]['opening_lag_t2_deg']:.2f} deg" + (" (the thesis's)" if value == phi else ""))
+    lines.append(("Every measured sliding-mode cell is within tolerance at phi " + ", ".join(f"{v:g}" for v in fitting)
+                  + " m/s." if fitting else "No phi run puts every measured sliding-mode cell within tolerance.")
+                 + " A what-if only: every other command runs the thesis's phi.")
+    return "\n".join(lines)
+
+
+def plot_phi(rows: Sequence[dict], path: pathlib.Path, *, thesis_phi: float) -> None:
+    """One panel a trajectory: sliding mode against phi, FF + PVA on the same seeds, the measured band."""
+    fig, axes = plt.subplots(2, 2, figsize=(9, 6), sharex=True, constrained_layout=True)
+    for ax, t in zip(axes.flat, TRAJECTORIES, strict=True):
+        group = sorted((r for r in rows if r["controller"] == "smc" and r["trajectory"] == t),
+                       key=lambda r: r["phi_m_s"])
+        ax.errorbar([r["phi_m_s"] for r in group], [r["rmse_mean_deg"] for r in group],
+                    yerr=[r["rmse_std_deg"] for r in group], marker="o", capsize=3, label="sliding mode")
+        measured = group[0]["measured_deg"]
+        ax.axhspan(measured * (1 - TOLERANCE), measured * (1 + TOLERANCE), color="tab:green", alpha=0.15, lw=0,
+                   label=f"measured sliding mode +-{TOLERANCE:.0%}")
+        ax.axhline(measured, color="tab:green", lw=1.0)
+        ffpva = next(r["rmse_mean_deg"] for r in rows if r["controller"] == "ffpva" and r["trajectory"] == t)
+        ax.axhline(ffpva, color="tab:orange", ls="--", lw=1.0, label="twin FF + PVA")
+        ax.axvline(thesis_phi, color="0.5", ls=":", lw=1.0, label="the thesis's phi")
+        ax.set_title(f"T{t}", fontsize=9)
+        ax.set_ylabel("RMSE (deg)")
+    for ax in axes[-1]:
+        ax.set_xlabel("boundary layer phi (m/s)")
+    finish_panels(fig, axes.flat, path, legend_size=7)
+
+
+class SmcPhiWhatIf(Experiment):
+    name = "smc-phi"
+    help = "sliding mode against its boundary layer phi, on the Chapter 5 experiments (nothing else changes)"
+    default_plant = "as-built"
+
+    def add_arguments(self, parser: argparse.ArgumentParser) -> None:
+        add_common_arguments(parser, self.default_plant, seeds=False)
+        parser.add_argument("--seeds", type=positive_int, default=10, help="noise seeds per case (default 10)")
+        parser.add_argument("--phis", default=",".join(f"{p:g}" for p in DEFAULT_PHIS), metavar="LIST",
+                            help="boundary layers in m/s (default 0.1,0.15,0.2,0.3; the thesis's 0.3 always runs)")
+
+    def check(self, args: argparse.Namespace) -> None:
+        args.phi_values = parse_phis(args.phis)
+
+    def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
+        with progress_bar(self.name) as bar:
+            return phi_study(phis=args.phi_values, seeds=args.seeds, plant_name=args.plant, bar=bar)
+
+    def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
+        plot_phi(outcome.rows, path, thesis_phi=outcome.detail)
+
+
+EXPERIMENT = SmcPhiWhatIf()
