@@ -85,10 +85,15 @@ def phi_study(*, phis: Sequence[float], seeds: int = 10, plant_name: str = "as-b
 def answer(rows: Sequence[dict], *, phi: float, seeds: int, plant_name: str) -> str:
     ffpva = {r["trajectory"]: r["rmse_mean_deg"] for r in rows if r["controller"] == "ffpva"}
     smc = [r for r in rows if r["controller"] == "smc"]
-    lines = [f"Sliding mode on {plant_name} against its boundary layer phi (the thesis's: {phi:g} m/s), T1-T4, "
-             f"seeds 0-{seeds - 1}; mean RMSE in deg, x measured, and the closed-form lag at which it opens the valve "
-             f"on T2. FF + PVA on the same seeds: " + " / ".join(f"{ffpva[t]:.2f}" for t in TRAJECTORIES)
-             + f" (lag {next(r['opening_lag_t2_deg'] for r in rows if r['controller'] == 'ffpva'):.2f} deg)."]
+    def lag(value: float) -> str:
+        return "" if math.isnan(value) else f"; lag {value:.2f} deg"
+
+    runs = "seed 0" if seeds == 1 else f"seeds 0-{seeds - 1}"
+    ffpva_lag = next(r["opening_lag_t2_deg"] for r in rows if r["controller"] == "ffpva")
+    lines = [f"Sliding mode on {plant_name} against its boundary layer phi (the thesis's: {phi:g} m/s), T1-T4, {runs}; "
+             "mean RMSE in deg, x measured, and the closed-form lag at which it opens the valve on T2 (none where the "
+             "valve has no opening threshold). FF + PVA on the same seeds: "
+             + " / ".join(f"{ffpva[t]:.2f}" for t in TRAJECTORIES) + lag(ffpva_lag) + "."]
     fitting = []
     for value in sorted({r["phi_m_s"] for r in smc}, reverse=True):
         group = sorted((r for r in smc if r["phi_m_s"] == value), key=lambda r: r["trajectory"])
@@ -97,11 +102,11 @@ def answer(rows: Sequence[dict], *, phi: float, seeds: int, plant_name: str) -> 
         if within == len(group):
             fitting.append(value)
         lines.append(f"phi {value:g} m/s: " + " / ".join(f"{r['rmse_mean_deg']:.2f} (x{r['ratio']:.2f})" for r in group)
-                     + f"; within {TOLERANCE:.0%} on {within} of {len(group)}, ahead of FF + PVA on {ahead}; "
-                     f"lag {group[0]['opening_lag_t2_deg']:.2f} deg" + (" (the thesis's)" if value == phi else ""))
-    lines.append(("Every measured sliding-mode cell is within tolerance at phi " + ", ".join(f"{v:g}" for v in fitting)
-                  + " m/s." if fitting else "No phi run puts every measured sliding-mode cell within tolerance.")
-                 + " A what-if only: every other command runs the thesis's phi.")
+                     + f"; within {TOLERANCE:.0%} on {within} of {len(group)}, ahead of FF + PVA on {ahead}"
+                     + lag(group[0]["opening_lag_t2_deg"]) + (" (the thesis's)" if value == phi else ""))
+    lines.append(("Of the phis run, every measured sliding-mode cell is within tolerance at " + ", ".join(
+        f"{v:g}" for v in fitting) + " m/s." if fitting else "No phi run puts every measured sliding-mode cell "
+                  "within tolerance.") + " A what-if, not a fit: every other command runs the thesis's phi.")
     return "\n".join(lines)
 
 
@@ -139,7 +144,12 @@ class SmcPhiWhatIf(Experiment):
                             help="boundary layers in m/s (default 0.1,0.15,0.2,0.3; the thesis's 0.3 always runs)")
 
     def check(self, args: argparse.Namespace) -> None:
+        from twin.plants import plant
+
         args.phi_values = parse_phis(args.phis)
+        if plant(args.plant).gain_set != "experiment":
+            raise InvalidScenario(f"--plant {args.plant} runs the thesis's simulation gains; smc-phi compares with the "
+                                  "rig's measurements, so it needs a plant with the experiment gains (as-built)")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:
