@@ -198,55 +198,71 @@ def test_whatif_supply_writes_its_answer_and_refuses_a_plant_with_a_constant_sup
 
 def test_smc_phi_changes_phi_alone_and_reports_against_the_measurements():
     """At the thesis's phi the what-if's sliding mode is the thesis's controller to the last bit, and its FF + PVA
-    the thesis's too (both against plain runs of the same seeds); a stronger switching term (smaller phi) opens the
-    valve at a smaller lag, as the closed form has it; the answer says where every measured cell is within 20 %."""
+    the thesis's too (both against plain runs of the same cells and seed), on every cell sliding mode was measured
+    on; a stronger switching term (smaller phi) opens the valve at a smaller lag, as the closed form has it."""
     from twin.envs.runner import run_many
-    from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
-    from twin.experiments.whatifs.smc_phi import TRAJECTORIES, phi_study
-    from twin.sim.scenario import Scenario
+    from twin.experiments.calibrate import TARGET_OF
+    from twin.experiments.whatifs.ensemble import cell_scenario
+    from twin.experiments.whatifs.smc_phi import measured_cells, phi_study
+    from twin.plants import plant
 
+    cells = [t.key[1:] for t in measured_cells()]
+    assert len(cells) == 9 and cells[:4] == [(t, 0.0, "horizontal") for t in (1, 2, 3, 4)]
     outcome = phi_study(phis=(0.2,), seeds=1)
     rows = outcome.rows
     assert {(r["controller"], r["phi_m_s"]) for r in rows} == {("smc", 0.2), ("smc", 0.3), ("ffpva", None)}
-    assert len(rows) == 3 * len(TRAJECTORIES) and outcome.failed == 0
-    plain = run_many([Scenario(c, t, plant="as-built", seed=0) for c in ("smc", "ffpva") for t in TRAJECTORIES])
-    expected = {(r.scenario.controller, r.scenario.trajectory): math.degrees(r.metrics.rmse) for r in plain}
+    assert len(rows) == 3 * len(cells) and outcome.failed == 0
+    base = plant("as-built")
+    plain = run_many([cell_scenario((c, *cell), base, 0) for c in ("smc", "ffpva") for cell in cells])
+    expected = {(r.scenario.controller, r.scenario.trajectory, round(r.scenario.payload * 1e3, 9),
+                 r.scenario.orientation.value): math.degrees(r.metrics.rmse) for r in plain}
     for r in rows:
-        assert r["measured_deg"] == THESIS_EXPERIMENT_RMSE_DEG[r["controller"]][r["trajectory"]][0]
+        key = (r["controller"], r["trajectory"], r["payload_g"], r["orientation"])
+        assert r["measured_deg"] == TARGET_OF[key].rmse_deg and r["source"] == TARGET_OF[key].source
         if r["phi_m_s"] in (0.3, None):
-            assert r["rmse_mean_deg"] == expected[(r["controller"], r["trajectory"])]
+            assert r["rmse_mean_deg"] == expected[key]
     lag = {(r["controller"], r["phi_m_s"]): r["opening_lag_t2_deg"] for r in rows}
     assert lag[("smc", 0.2)] < lag[("smc", 0.3)]
     assert "the thesis's: 0.3 m/s" in outcome.answer and "A what-if, not a fit" in outcome.answer
+    assert "On the rig sliding mode was ahead of FF + PVA on 9 of 9." in outcome.answer
 
 
 def test_smc_phi_answer_counts_the_cells_within_tolerance_and_ahead():
-    """Made-up rows: a ratio of exactly 1.2 is within; 'ahead' compares with FF + PVA per trajectory; a phi at
-    which some cell is out is not named; no lag (nan) is not printed."""
-    from twin.experiments.whatifs.smc_phi import TRAJECTORIES, answer
+    """Made-up rows: a ratio of exactly 1.2 is within; 'ahead' compares with FF + PVA per cell; a phi at which some
+    cell is out is not named; no lag (nan) is not printed."""
+    from twin.experiments.whatifs.smc_phi import answer
 
-    def row(controller, phi, t, rmse, measured, lag=2.0):
-        return {"controller": controller, "phi_m_s": phi, "trajectory": t, "rmse_mean_deg": rmse,
-                "rmse_std_deg": 0.1, "measured_deg": measured, "ratio": rmse / measured, "opening_lag_t2_deg": lag}
+    cells = [("chapter 5 experiment", 1, 0.0, "horizontal"), ("chapter 5 experiment", 2, 0.0, "horizontal"),
+             ("chapter 6 T1", 1, 13.5, "vertical")]
 
-    rows = [row("ffpva", None, t, 2.0, 2.0) for t in TRAJECTORIES]
-    rows += [row("smc", 0.3, t, r, 1.0) for t, r in zip(TRAJECTORIES, (1.2, 1.5, 2.5, 0.9), strict=True)]
-    rows += [row("smc", 0.2, t, r, 1.0) for t, r in zip(TRAJECTORIES, (1.2, 0.8, 1.0, 1.1), strict=True)]
+    def row(controller, phi, cell, rmse, measured, lag=2.0):
+        source, t, g, o = cell
+        return {"controller": controller, "phi_m_s": phi, "source": source, "trajectory": t, "payload_g": g,
+                "orientation": o, "rmse_mean_deg": rmse, "rmse_std_deg": 0.1, "measured_deg": measured,
+                "ratio": rmse / measured, "opening_lag_t2_deg": lag}
+
+    rows = [row("ffpva", None, c, 2.0, 2.0) for c in cells]
+    rows += [row("smc", 0.3, c, r, 1.0) for c, r in zip(cells, (1.2, 2.5, 0.9), strict=True)]
+    rows += [row("smc", 0.2, c, r, 1.0) for c, r in zip(cells, (1.2, 0.8, 1.1), strict=True)]
     text = answer(rows, phi=0.3, seeds=1, plant_name="as-built")
-    assert "seed 0;" in text
-    assert "phi 0.3 m/s: 1.20 (x1.20) / 1.50 (x1.50) / 2.50 (x2.50) / 0.90 (x0.90); within 20% on 2 of 4, ahead of " \
-           "FF + PVA on 3; lag 2.00 deg (the thesis's)" in text
-    assert "within 20% on 4 of 4, ahead of FF + PVA on 4" in text
+    assert "seed 0;" in text and "On the rig sliding mode was ahead of FF + PVA on 3 of 3." in text
+    assert ("phi 0.3 m/s: T1 1.20 (x1.20), T2 2.50 (x2.50), T1 13.5 g V 0.90 (x0.90); within 20% on 1 of 2 "
+            "(chapter 5 experiment), 1 of 1 (chapter 6 T1); ahead of FF + PVA on 2 of 3; lag on T2 2.00 deg "
+            "(the thesis's)") in text
+    assert "within 20% on 2 of 2 (chapter 5 experiment), 1 of 1 (chapter 6 T1); ahead of FF + PVA on 3 of 3" in text
     assert "every measured sliding-mode cell is within tolerance at 0.2 m/s." in text
     none = [dict(r, opening_lag_t2_deg=math.nan) for r in rows if r["phi_m_s"] != 0.2]
     text = answer(none, phi=0.3, seeds=3, plant_name="as-built")
     assert "No phi run puts every measured sliding-mode cell within tolerance." in text
     assert "nan" not in text and "seeds 0-2" in text
+    chapter5 = [dict(r, ratio=0.5) if r["phi_m_s"] == 0.2 and r["payload_g"] else r for r in rows]
+    assert ("No phi run puts every measured sliding-mode cell within tolerance; every chapter 5 experiment cell is "
+            "at 0.2 m/s.") in answer(chapter5, phi=0.3, seeds=3, plant_name="as-built")
 
 
 def test_whatif_smc_phi_cli_writes_its_table_and_plot(tmp_path):
     out = tmp_path / "phi"
     rows = _whatif_rows(out, "smc-phi", "--seeds", "1", "--phis", "0.3")
-    assert [(r["controller"], r["phi_m_s"]) for r in rows] == [("smc", "0.3")] * 4 + [("ffpva", "")] * 4
+    assert [(r["controller"], r["phi_m_s"]) for r in rows] == [("smc", "0.3")] * 9 + [("ffpva", "")] * 9
     assert (out / "smc-phi.png").read_bytes().startswith(b"\x89PNG")
     assert "A what-if, not a fit" in (out / "smc-phi.txt").read_text()
