@@ -199,14 +199,21 @@ def opening_ticks(params, period_ticks: int, tick: float) -> int:
     raise ValueError("the valve does not open even on a full period")
 
 
-def opening_lag(controller, nominal, position: float, speed: float, *, ticks_to_open: int, period_ticks: int,
-                tick: float) -> float:
+def opening_command(ticks_to_open: int, period_ticks: int) -> float:
+    """The held duty (%) above which a pulse reaches ``ticks_to_open`` of the period's ``period_ticks`` ticks
+    (the coil switches on whole ticks: a duty d is rint(d S / 100) ticks; at the limit itself, half to even)."""
+    return (ticks_to_open - 0.5) / period_ticks * 100.0
+
+
+def opening_lag(controller, nominal, position, speed: float, *, ticks_to_open: int, period_ticks: int,
+                tick: float):
     """Closed form: the error (m, >= 0) at a period's start at which ``controller`` (built by
     ``controllers.make_controller``) first commands a pulse that opens the valve, with the reference at
-    ``position`` moving at ``speed`` > 0 (a_d = 0) and the joint at rest behind it (v_hat = a_hat = 0). The coil
-    is on at the period's tick k while rint(u_k S / 100) > k (S = ``period_ticks``), so a pulse reaches the
-    ``ticks_to_open`` = n ticks that open the valve (:func:`opening_ticks`) once u_{n-1} > (n - 1/2) 100 / S %
-    (the lag is that limit). With u_FF the feed-forward at ``position`` and v = ``speed``:
+    ``position`` (m, a float or an array) moving at ``speed`` > 0 (a_d = 0) and the joint at rest behind it
+    (v_hat = a_hat = 0). The coil is on at the period's tick k while rint(u_k S / 100) > k (S =
+    ``period_ticks``), so a pulse reaches the ``ticks_to_open`` = n ticks that open the valve
+    (:func:`opening_ticks`) once u_{n-1} passes :func:`opening_command` (the lag is that limit). With u_FF the
+    feed-forward at ``position`` and v = ``speed``:
 
     - PVA + DZC (held for the period): past its threshold its compensation adds 30 %, which opens the valve if
       K_p e + K_v v + 30 % does; before it, K_p e + K_v v must open it on its own: the smaller error;
@@ -214,39 +221,43 @@ def opening_lag(controller, nominal, position: float, speed: float, *, ticks_to_
       is a pulse of n ticks: e = (20 % - u_FF - K_v v) / K_p;
     - sliding mode: u_FF+PVA held from the period's start, the switching term every tick, while the error grows
       by v per second: u_{n-1} = u_FF + K_p e + K_v v + 100 % (v + lambda (e + (n - 1) tick v)) / phi, unsaturated.
+
+    Returns a float for a float ``position``, else an array of its shape.
     """
     from controllers import PVA, FeedForwardPVA, SlidingMode
     from controllers.feedforward import feedforward_duty
 
     if not speed > 0:
         raise ValueError(f"the reference must move forwards, got {speed} m/s")
-    opening = (ticks_to_open - 0.5) / period_ticks * 100.0  # %: the pulse's threshold command
+    opening = opening_command(ticks_to_open, period_ticks)
 
     def opens(duty: float) -> bool:
         return np.rint(duty / 100.0 * period_ticks) >= ticks_to_open
 
-    u_ff = float(feedforward_duty(nominal, np.array([position]), np.array([speed]), np.zeros(1))[0])
+    where = np.asarray(position, dtype=float)
+    u_ff = feedforward_duty(nominal, where, np.full(where.shape, speed), np.zeros(where.shape))
     if isinstance(controller, PVA):
         g = controller.gains
         alone = max(opening - g.velocity * speed, 0.0) / g.position
         threshold = controller.compensation_threshold
         lifted = g.position * threshold + g.velocity * speed + controller.compensation
-        return min(threshold, alone) if opens(lifted) else alone
-    if isinstance(controller, FeedForwardPVA):
+        lag = np.full(where.shape, min(threshold, alone) if opens(lifted) else alone)
+    elif isinstance(controller, FeedForwardPVA):
         g = controller.gains.pva
         low, high = controller.gains.compensation_band
         edge = min(low, opening) if opens(high) else opening
-        return max(edge - u_ff - g.velocity * speed, 0.0) / g.position
-    if isinstance(controller, SlidingMode):
+        lag = np.maximum(edge - u_ff - g.velocity * speed, 0.0) / g.position
+    elif isinstance(controller, SlidingMode):
         g = controller.gains
         per_speed = g.switching_amplitude / g.boundary_layer  # %/(m/s)
         grown = (ticks_to_open - 1) * tick * speed  # m the error grows before the binding tick
-        lag = (max(opening - u_ff - g.pva.velocity * speed - per_speed * (speed + g.surface_slope * grown), 0.0)
+        lag = (np.maximum(opening - u_ff - g.pva.velocity * speed - per_speed * (speed + g.surface_slope * grown), 0.0)
                / (g.pva.position + per_speed * g.surface_slope))
-        if speed + g.surface_slope * (lag + grown) >= g.boundary_layer:
+        if np.any(speed + g.surface_slope * (lag + grown) >= g.boundary_layer):
             raise ValueError("the switching term saturates before the valve opens: no closed form here")
-        return lag
-    raise TypeError(f"no closed form for {type(controller).__name__}")
+    else:
+        raise TypeError(f"no closed form for {type(controller).__name__}")
+    return lag if lag.ndim else float(lag)
 
 
 def ramp_opening_lags(plant, nominal, laws: dict) -> dict:
@@ -263,11 +274,16 @@ def ramp_opening_lags(plant, nominal, laws: dict) -> dict:
     ramp = trajectory(2, spur_radius=radius)
     positions = ramp.sample(np.arange(0.0, ramp.duration, plant.timestep), radius).position
     u_ff = feedforward_duty(nominal, positions, np.full(positions.shape, RAMP_SPEED), np.zeros(positions.shape))
-    lags = {name: math.degrees(float(np.median([
-        opening_lag(law, nominal, float(y), RAMP_SPEED, ticks_to_open=n_open, period_ticks=period_ticks,
-                    tick=plant.timestep) for y in positions])) / radius) for name, law in laws.items()}
-    return {"lag_deg": lags, "opening_pct": (n_open - 0.5) / period_ticks * 100.0,
+    lags = {name: math.degrees(float(np.median(opening_lag(
+        law, nominal, positions, RAMP_SPEED, ticks_to_open=n_open, period_ticks=period_ticks, tick=plant.timestep)))
+        / radius) for name, law in laws.items()}
+    return {"lag_deg": lags, "opening_pct": opening_command(n_open, period_ticks),
             "feedforward_pct": (float(u_ff.min()), float(u_ff.max()))}
+
+
+def opening_starts(discharge_open: np.ndarray) -> np.ndarray:
+    """Indices at which ``discharge_open`` (T,) bool turns true: where a discharge valve opens."""
+    return np.flatnonzero(np.diff(np.concatenate(([False], discharge_open)).astype(int)) == 1)
 
 
 def pulse_statistics(time: np.ndarray, desired: np.ndarray, scored: np.ndarray, discharge_open: np.ndarray
@@ -275,7 +291,7 @@ def pulse_statistics(time: np.ndarray, desired: np.ndarray, scored: np.ndarray, 
     """One run's pulses: ``discharge_open`` (T,) bool, either discharge valve open; angles in rad. Returns the
     openings per second, and per opening the advance of the scored angle until the next opening (or the
     run's end) and the error |desired - scored| when the valve opened, each as a list in deg."""
-    opened = np.flatnonzero(np.diff(np.concatenate(([False], discharge_open)).astype(int)) == 1)
+    opened = opening_starts(discharge_open)
     ends = np.append(opened[1:], len(time) - 1)
     return {"openings_per_s": len(opened) / (time[-1] - time[0] + (time[1] - time[0])),
             "advance_deg": [math.degrees(abs(scored[b] - scored[a])) for a, b in zip(opened, ends, strict=True)],
@@ -285,8 +301,8 @@ def pulse_statistics(time: np.ndarray, desired: np.ndarray, scored: np.ndarray, 
 def pulse_cycle(committed: dict[str, float]) -> dict:
     """How the as-built controllers move the joint on the slow trajectories (Chapter 5, horizontal, no payload,
     seeds 0-4): per controller and trajectory the runs' mean RMSE, their openings per second and the medians
-    of :func:`pulse_statistics` (and T2's first run, for :func:`figure_pulses`); per controller the closed-form :func:`opening_lag` on T2 (deg, the median
-    over T2's reference); T2's feed-forward duty (%, lowest and highest), the command that opens the valve
+    of :func:`pulse_statistics` (and T2's first run, for :func:`figure_pulses`); per controller the closed-form
+    :func:`opening_lag` on T2 (deg, the median over T2's reference); T2's feed-forward duty (%, lowest and highest), the command that opens the valve
     (%), how far T2's reference moves in a PWM period (deg), the valve's opening delay (ms) and sliding mode's
     phi (m/s)."""
     import controllers
@@ -321,9 +337,10 @@ def pulse_cycle(committed: dict[str, float]) -> dict:
         if key[1] == 2:
             out["example"][key[0]] = (runs[0].trace.time, np.degrees(runs[0].trace.desired_angle - scored[0]),
                                       opened[0])
+        rmse = spread([math.degrees(r.metrics.rmse) for r in runs])
         out["runs"][key] = {
-            "rmse_deg": spread([math.degrees(r.metrics.rmse) for r in runs]).mean,
-            "rmse_std_deg": spread([math.degrees(r.metrics.rmse) for r in runs]).std,
+            "rmse_deg": rmse.mean,
+            "rmse_std_deg": rmse.std,
             "openings_per_s": float(np.mean([s["openings_per_s"] for s in stats])),
             "advance_deg": float(np.median(np.concatenate([s["advance_deg"] for s in stats]))),
             "error_at_opening_deg": float(np.median(np.concatenate([s["error_at_opening_deg"] for s in stats])))}
@@ -670,7 +687,7 @@ def figure_pulses(v: Validation, path: pathlib.Path) -> None:
                              sharey=True, constrained_layout=True, squeeze=False)
     for ax, (name, (time, error, opened)) in zip(axes[:, 0], example.items(), strict=False):
         ax.plot(time, error, color="tab:blue", lw=1.0, label="error (deg)")
-        starts = np.flatnonzero(np.diff(np.concatenate(([False], opened)).astype(int)) == 1)
+        starts = opening_starts(opened)
         ax.vlines(time[starts], 0.0, error[starts], color="tab:red", lw=1.0, label="a discharge valve opens")
         ax.axhline(v.pulses["lag_deg"][name], color="k", ls="--", lw=0.8,
                    label=f"closed-form lag {v.pulses['lag_deg'][name]:.2f} deg")

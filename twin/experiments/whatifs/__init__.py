@@ -9,7 +9,7 @@ supply     the as-built supply line against an accumulator and a constant supply
 pva-rate   FF + PVA updated inside the PWM period (SPEC §10), over the calibration ensemble
 observer   a Kalman velocity/acceleration observer against eq. 5.2.2's (SPEC §10), over the ensemble
 next-experiment  which rig experiment narrows the Chapter 6 prediction bands most per hour
-smc-phi    sliding mode against its boundary layer phi on the Chapter 5 experiments (nothing else changes)
+smc-phi    sliding mode against its boundary layer phi on every measured sliding-mode cell (nothing else changes)
 
 A new what-if is a new module with an ``EXPERIMENT`` object, listed in ``WHATIFS``.
 """

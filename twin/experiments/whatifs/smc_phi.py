@@ -82,11 +82,13 @@ def phi_study(*, phis: Sequence[float], seeds: int = 10, plant_name: str = "as-b
                        controllers=[laws[key] for key, _, _ in jobs], progress=batch_progress(bar, len(jobs)))
     lags = (validate.ramp_opening_lags(base, nominal, laws)["lag_deg"]
             if base.valve_model is ValveModel.SOLENOID else {})  # no valve threshold to reach: no closed form
+    rmse: dict[tuple, list[float]] = {}  # (law key, cell) -> the runs' RMSE, deg
+    for (key, cell, _), r in zip(jobs, results, strict=True):
+        rmse.setdefault((key, cell), []).append(math.degrees(r.metrics.rmse))
     rows = []
     for key in laws:
         for cell in cells:
-            runs = [r for (k, c, _), r in zip(jobs, results, strict=True) if k == key and c == cell]
-            s = spread([math.degrees(r.metrics.rmse) for r in runs])
+            s = spread(rmse[(key, cell)])
             target = TARGET_OF[(key[0], *cell)]
             rows.append(dict(zip(COLUMNS, (key[0], key[1], target.source, *cell, s.mean, s.std, target.rmse_deg,
                                            s.mean / target.rmse_deg, lags.get(key, math.nan)), strict=True)))
@@ -128,8 +130,8 @@ def answer(rows: Sequence[dict], *, phi: float, seeds: int, plant_name: str) -> 
                      + f"; ahead of FF + PVA on {ahead} of {len(group)}" + lag(group[0]["opening_lag_t2_deg"])
                      + (" (the thesis's)" if value == phi else ""))
     every = [v for v, by in fitting.items() if all(n == total for n, total in by.values())]
-    first = next(iter(next(iter(fitting.values()))), None)
-    chapter5 = [v for v, by in fitting.items() if first and by[first][0] == by[first][1]]
+    first = smc[0]["source"]  # the thesis's own table (§8) comes first
+    chapter5 = [v for v, by in fitting.items() if by[first][0] == by[first][1]]
     lines.append(("Of the phis run, every measured sliding-mode cell is within tolerance at "
                   + ", ".join(f"{v:g}" for v in every) + " m/s." if every else
                   "No phi run puts every measured sliding-mode cell within tolerance"
