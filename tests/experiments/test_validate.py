@@ -33,7 +33,7 @@ def rows_of(path: pathlib.Path) -> tuple[list[str], list[dict]]:
         return list(reader.fieldnames or []), list(reader)
 
 
-@pytest.mark.slow  # about 80 s on 2 cores: every comparison and the ensemble's T3 runs
+@pytest.mark.slow  # about 110 s on 2 cores: every comparison, 40 more seeds and the ensemble's T3 runs
 def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
     out = tmp_path / "v"
     proc = twin(tmp_path, "validate", "--out", str(out))
@@ -62,7 +62,12 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
     report = (out / "validation.md").read_text()
     assert "## Why, as far as the twin shows" in report and "## Prediction: Chapter 6 T3 (blind)" in report
     assert "![T2's first run" in report
-    for name in ("validation.png", "prediction.png", "pulses.png"):
+    columns, more = rows_of(out / "seeds.csv")
+    assert columns == list(validate.SEED_COLUMNS) and len(more) == 21
+    assert {r["seeds"] for r in more} == {"40-79"} and {r["groups"] for r in more} == {"8"}
+    assert sum(r["sse_twin"] != "" for r in more) == 13
+    assert "## Five runs or 40: the measured cells on seeds 40-79" in report
+    for name in ("validation.png", "prediction.png", "pulses.png", "seeds.png"):
         assert (out / name).read_bytes().startswith(b"\x89PNG")
     assert not list(out.glob("*.tmp*"))
     assert "wrote" in proc.stdout and "prediction.csv" in proc.stdout
@@ -294,3 +299,58 @@ def test_report_shows_the_pulse_cycle_and_each_laws_opening_lag():
     assert "The rig's sliding mode" not in text and "FF + PVA and sliding mode on the twin: T2: 2.26" in text
     v.pulses["feedforward_pct"] = (20.0, 40.0)
     assert "partly above the 28.1 % that opens the valve" in validate.report(v)
+
+
+def test_fresh_seeds_are_eight_five_run_groups_no_step_of_the_calibration_ran():
+    from twin.experiments import calibrate
+
+    used = set(calibrate.FIT_SEEDS) | set(calibrate.CHECK_SEEDS) | {s for g in calibrate.NOISE_SEED_SETS for s in g}
+    assert len(validate.FRESH_SEEDS) == len(set(validate.FRESH_SEEDS)) == 8 * calibrate.THESIS_RUNS
+    assert not used & set(validate.FRESH_SEEDS) and not set(validate.SEEDS) & set(validate.FRESH_SEEDS)
+
+
+def _cell(key, rmse, sse, first_seed=40):
+    from twin.experiments import calibrate
+
+    return calibrate.CellResult(key[0], key[1], tuple(rmse), tuple(sse), seeds=tuple(range(first_seed, first_seed + len(rmse))),
+                                payload_g=key[2], orientation=key[3])
+
+
+def test_seed_rows_count_the_five_run_groups_within_tolerance():
+    """Made-up runs on two measured cells: FF + PVA T1 (measured 1.40 ± 0.06, SSE range 0.77) and sliding
+    mode T2 (1.55, no SSE). Each number below is worked by hand from them."""
+    ffpva, smc = ("ffpva", 1, 0.0, "horizontal"), ("smc", 2, 0.0, "horizontal")
+    # FF + PVA: groups of five with means 1.40, 1.80 (x1.29, out) and 1.20 (x0.86, in); a last run left out.
+    rmse = [1.4] * 5 + [1.8] * 5 + [1.2] * 5 + [9.9]
+    sse = [0.1, -0.7, 0.2, 0.0, 0.3] + [0.1, 0.2, 0.0, 0.1, -0.2] + [math.nan] * 5 + [5.0]
+    fresh = [_cell(ffpva, rmse, sse), _cell(smc, [2.0] * 10, [math.nan] * 10)]
+    five = [_cell(ffpva, [1.0] * 5, [0.5] * 5, first_seed=0), _cell(smc, [2.3] * 5, [math.nan] * 5, first_seed=0)]
+    first, second = validate.seed_rows(fresh, five)
+    assert first["seeds"] == "40-55" and first["five_run_mean"] == pytest.approx(1.0)
+    assert first["twin_mean"] == pytest.approx((7 + 9 + 6 + 9.9) / 16)  # the mean takes every run
+    assert first["groups"] == 3 and first["groups_within"] == 2
+    assert (first["group_low"], first["group_high"]) == pytest.approx((1.2, 1.8))
+    assert first["measured_se"] == pytest.approx(0.06 / math.sqrt(5))
+    # SSE: the ranges are 0.7 (within 0.5 of 0.77) and 0.2 (0.57 off); the all-nan group is left out.
+    assert first["sse_group_values"] == pytest.approx([0.7, 0.2]) and first["sse_groups_within"] == 1
+    assert first["sse_twin"] == pytest.approx(0.45) and first["sse_within_tolerance"] is True  # 0.32 off
+    assert first["sse_five_run"] == pytest.approx(0.5)
+    assert second["ratio"] == pytest.approx(2.0 / 1.55) and second["within_tolerance"] is False
+    assert second["groups_within"] == 0 and second["sse_twin"] is None and second["sse_groups_within"] is None
+
+
+def test_report_says_which_misses_hold_on_every_five_run_draw():
+    v = _fake(1.0, lag_within=True, stalled=0)
+    assert "Five runs or" not in validate.report(v)  # not run: no line, no table
+    ffpva, smc = ("ffpva", 1, 0.0, "horizontal"), ("smc", 2, 0.0, "horizontal")
+    fresh = [_cell(ffpva, [1.4] * 5 + [1.8] * 5, [0.7] * 5 + [0.2] * 5), _cell(smc, [2.0] * 10, [math.nan] * 10)]
+    five = [_cell(ffpva, [1.4] * 5, [0.5] * 5, first_seed=0), _cell(smc, [2.325] * 5, [math.nan] * 5, first_seed=0)]
+    v.seeds = validate.seed_rows(fresh, five)
+    text = validate.report(v)
+    assert "| chapter 5 experiment and chapter 6 T1, on 10 more seeds (40-49) | as-built | 1 of 2 |" in text
+    assert "| T1 SSE range, on 10 more seeds (40-49) | as-built | 1 of 1 |" in text
+    assert "on the 10-run mean, 1 of 2 RMSE cells are within 20 % (on seeds 0-4: 1)" in text
+    assert "Out in every five-run group, so not the draw: sliding mode T2 (x1.29)." in text
+    assert "In on some draws of five runs and out on others: FF + PVA T1 (seeds 0-4 x1.00, 10 runs x1.14, 1 of 2" in text
+    assert "| FF + PVA | 1 | 0 g | horizontal | 1.40 ± 0.03 | 1.40 | 1.60 ± 0.21 | 1.14 | yes | 1 of 2 (1.40-1.80) |" in text
+    assert "(seeds.png)" in text

@@ -15,7 +15,9 @@ chapter 6 T1                    as-built      within 20 %
 4.6 open-loop lag               as-built      the real joint lagged the thesis's model at each reversal
 ==============================  ============  =======================================================
 
-Every closed-loop cell runs the thesis's five runs (seeds 0-4). The prediction (``prediction.csv``)
+Every closed-loop cell runs the thesis's five runs (seeds 0-4); the verdicts judge those. Every
+measured cell also runs on :data:`FRESH_SEEDS` (``seeds.csv``, :func:`seed_rows`): forty noise seeds that
+no step of the calibration ran, to show which verdicts are the draw of five runs. The prediction (``prediction.csv``)
 runs the T3 cells (FF + PVA and sliding mode, 0 / 6.5 / 13.5 g, horizontal and vertical) on the
 committed preset and on every member of the calibration ensemble (:func:`ensemble_values`), five
 runs each: ``twin_mean`` is the committed preset's mean RMSE, the band the 10 / 50 / 90 %
@@ -53,6 +55,16 @@ VALIDATION_COLUMNS = ("source", "controller", "trajectory", "payload_g", "orient
                       "twin_mean", "twin_std", "ratio", "within_tolerance")
 PREDICTION_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "twin_mean", "band_p10", "band_p50",
                       "band_p90", "stalled_runs")
+# Forty more runs per measured cell, on noise seeds no step of `twin calibrate` ever ran (it fits on
+# FIT_SEEDS and measures its cost's noise on NOISE_SEED_SETS): eight five-run groups, to show how much of
+# each verdict on seeds 0-4 is the draw of five runs. Added 2026-11-25, after the eighth refit's results.
+FRESH_GROUPS = 8
+_FIRST_FRESH_SEED = max(*calibrate.FIT_SEEDS, *(s for group in calibrate.NOISE_SEED_SETS for s in group)) + 1
+FRESH_SEEDS = tuple(range(_FIRST_FRESH_SEED, _FIRST_FRESH_SEED + FRESH_GROUPS * calibrate.THESIS_RUNS))
+SEED_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "measured", "measured_se", "seeds",
+                "five_run_mean", "twin_mean", "twin_std", "ratio", "within_tolerance", "groups_within", "groups",
+                "group_low", "group_high", "sse_measured", "sse_five_run", "sse_twin", "sse_within_tolerance",
+                "sse_groups_within", "sse_group_low", "sse_group_high")
 
 
 def _row(source, controller, trajectory, payload_g, orientation, plant, measured, twin_mean, twin_std,
@@ -99,6 +111,50 @@ def measured_rows(cells: Sequence[calibrate.CellResult]) -> list[dict]:
                                  cell.orientation, "as-built", target.sse_range_deg, twin, None,
                                  twin is not None and abs(twin - target.sse_range_deg) <= SSE_TOLERANCE_DEG))
     return rows + sse_rows
+
+
+def _groups(values: Sequence[float]) -> list[np.ndarray]:
+    """``values`` taken five at a time in seed order (a last group of fewer is left out)."""
+    n = calibrate.THESIS_RUNS
+    return [np.asarray(values[i:i + n], dtype=float) for i in range(0, len(values) - n + 1, n)]
+
+
+def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.CellResult]) -> list[dict]:
+    """Each measured cell on many seeds (``fresh``) beside its five runs (``five``, seeds 0-4): the mean
+    over all and whether it is within tolerance, and how many of the five-run groups are; for T1 the
+    same for the steady-error range (the largest |SSE| of each group; groups whose runs all end moving
+    are left out)."""
+    five_of = {c.key: c for c in five}
+    rows = []
+    for cell in fresh:
+        target = calibrate.TARGET_OF[cell.key]
+        s = spread(cell.rmse_deg)
+        means = [float(g.mean()) for g in _groups(cell.rmse_deg)]
+
+        def within(x: float, measured: float = target.rmse_deg) -> bool:
+            return abs(x / measured - 1) <= RMSE_TOLERANCE
+
+        row = {"controller": cell.controller, "trajectory": cell.trajectory, "payload_g": cell.payload_g,
+               "orientation": cell.orientation, "measured": target.rmse_deg,
+               "measured_se": target.rmse_std_deg / math.sqrt(calibrate.THESIS_RUNS),
+               "seeds": f"{min(cell.seeds)}-{max(cell.seeds)}" if cell.seeds else "",
+               "five_run_mean": five_of[cell.key].mean_rmse if cell.key in five_of else None,
+               "twin_mean": s.mean, "twin_std": s.std, "ratio": s.mean / target.rmse_deg,
+               "within_tolerance": within(s.mean), "groups_within": sum(within(m) for m in means),
+               "groups": len(means), "group_low": min(means, default=None), "group_high": max(means, default=None),
+               "group_values": means, "sse_group_values": [], "sse_measured": None, "sse_five_run": None, "sse_twin": None, "sse_within_tolerance": None,
+               "sse_groups_within": None, "sse_group_low": None, "sse_group_high": None}
+        ranges = [float(np.nanmax(np.abs(g))) for g in _groups(cell.sse_deg) if not np.isnan(g).all()]
+        if target.sse_range_deg is not None and ranges:
+            close = [abs(r - target.sse_range_deg) <= SSE_TOLERANCE_DEG for r in ranges]
+            five_range = five_of[cell.key].sse_range if cell.key in five_of else math.nan
+            row.update(sse_measured=target.sse_range_deg, sse_five_run=None if math.isnan(five_range) else five_range,
+                       sse_twin=float(np.mean(ranges)),
+                       sse_within_tolerance=abs(float(np.mean(ranges)) - target.sse_range_deg) <= SSE_TOLERANCE_DEG,
+                       sse_groups_within=sum(close), sse_group_low=min(ranges), sse_group_high=max(ranges),
+                       sse_group_values=ranges)
+        rows.append(row)
+    return rows
 
 
 def valve_rows() -> list[dict]:
@@ -388,11 +444,12 @@ class Validation:
     stalled: dict  # (controller, trajectory, payload g, orientation) -> stalled runs of the committed preset
     sliding_mode: dict | None = None  # sliding_mode_parts
     pulses: dict | None = None  # pulse_cycle
+    seeds: list[dict] | None = None  # seed_rows on FRESH_SEEDS
 
 
 def validate(*, workers: int = 2, progress=None) -> Validation:
     """Every comparison, then the prediction; ``progress()`` after the simulations, the fitted cells, the
-    valve, the open loop, sliding mode's parts, the pulse cycle and each ensemble member."""
+    fresh seeds, the valve, the open loop, sliding mode's parts, the pulse cycle and each ensemble member."""
     from twin.plants.as_built import calibrated_values
 
     step = progress or (lambda: None)
@@ -403,6 +460,9 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
     try:
         cells = evaluator.cells(committed)
         rows += measured_rows(cells)
+        step()
+        fresh = evaluator.cells(committed, seeds=FRESH_SEEDS)
+        seeds = seed_rows(fresh, cells)
         step()
         rows += valve_rows()
         step()
@@ -416,9 +476,10 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
         predicted, own, detail = prediction(evaluator, committed, progress=step)
     finally:
         evaluator.close()
-    failed = sum(c.failed for c in (*cells, *own)) + sum(len(run.warnings) > 0 for run in study.runs)
+    failed = sum(c.failed for c in (*cells, *fresh, *own)) + sum(len(run.warnings) > 0 for run in study.runs)
     return Validation(rows=rows, prediction=predicted, prediction_detail=detail, failed=failed,
-                      stalled={c.key: stalled_runs(c) for c in cells}, sliding_mode=parts, pulses=pulses)
+                      stalled={c.key: stalled_runs(c) for c in cells}, sliding_mode=parts, pulses=pulses,
+                      seeds=seeds)
 
 
 def _fmt(value, spec=".2f") -> str:
@@ -478,6 +539,52 @@ def _why_pulses(pulses: dict | None, experiment: Sequence[dict]) -> list[str]:
     return [line]
 
 
+def _cell_name(r: dict) -> str:
+    heavy = r["payload_g"] or r["orientation"] == "vertical"
+    return (f"{CONTROLLER_LABELS[r['controller']]} T{r['trajectory']}"
+            + (f" {r['payload_g']:g} g {r['orientation']}" if heavy else ""))
+
+
+def _why_seeds(v: Validation) -> list[str]:
+    """How much of each verdict on seeds 0-4 is the draw of five runs (:func:`seed_rows`)."""
+    if not v.seeds:
+        return []
+    rows = v.seeds
+    groups = rows[0]["groups"]
+    five = {(r["controller"], r["trajectory"], r["payload_g"], r["orientation"]): r for r in v.rows
+            if r["source"] in ("chapter 5 experiment", "chapter 6 T1")}
+    five_in = sum(five[(r["controller"], r["trajectory"], r["payload_g"], r["orientation"])]["within_tolerance"]
+                  for r in rows if (r["controller"], r["trajectory"], r["payload_g"], r["orientation"]) in five)
+    never = [r for r in rows if r["groups_within"] == 0]
+    split = [r for r in rows if 0 < r["groups_within"] < r["groups"]]
+    line = (f"- **Five runs or {groups * calibrate.THESIS_RUNS}** (seeds {rows[0]['seeds']}, which no step of the "
+            f"calibration ran; {groups} groups of five): on the {groups * calibrate.THESIS_RUNS}-run mean, "
+            f"{sum(r['within_tolerance'] for r in rows)} of {len(rows)} RMSE cells are within "
+            f"{RMSE_TOLERANCE * 100:.0f} % (on seeds 0-4: {five_in}).")
+    if never:
+        line += (" Out in every five-run group, so not the draw: "
+                 + ", ".join(f"{_cell_name(r)} (x{r['ratio']:.2f})" for r in never) + ".")
+    if split:
+        line += (" In on some draws of five runs and out on others: "
+                 + ", ".join(f"{_cell_name(r)} (seeds 0-4 x{r['five_run_mean'] / r['measured']:.2f}, "
+                             f"{groups * calibrate.THESIS_RUNS} runs x{r['ratio']:.2f}, {r['groups_within']} of "
+                             f"{r['groups']} groups within)" for r in split) + ".")
+    sse = [r for r in rows if r["sse_twin"] is not None]
+    if sse:
+        widths = [r["sse_group_high"] - r["sse_group_low"] for r in sse]
+        five_sse = sum(r["sse_five_run"] is not None and abs(r["sse_five_run"] - r["sse_measured"]) <= SSE_TOLERANCE_DEG
+                       for r in sse)
+        line += (f" T1 steady-error ranges: {sum(r['sse_within_tolerance'] for r in sse)} of {len(sse)} within "
+                 f"±{SSE_TOLERANCE_DEG:g} deg on the groups' mean (on seeds 0-4: {five_sse}). The largest |SSE| "
+                 f"of five runs is a rough measure: across one cell's groups it spreads over "
+                 f"{float(np.median(widths)):.2f} deg (median over the cells; up to {max(widths):.2f}), against a "
+                 f"tolerance of ±{SSE_TOLERANCE_DEG:g}.")
+    se = [r["measured_se"] / r["measured"] for r in rows]
+    line += (f" The measured means carry their own five-run error: the thesis's std / sqrt 5 is "
+             f"{min(se) * 100:.0f}-{max(se) * 100:.0f} % of them.")
+    return [line]
+
+
 def _why(v: Validation) -> list[str]:
     """What the runs themselves show about the misses: computed, not written in advance."""
     rows = v.rows
@@ -507,6 +614,7 @@ def _why(v: Validation) -> list[str]:
             "the thesis's phi it adds " + listed(parts["trajectories"][t]["switching_rms_pct"] for t in ts)
             + " % of duty RMS. How it compares with FF + PVA turns on that term's strength against the dead zone.")
     lines += _why_pulses(v.pulses, experiment)
+    lines += _why_seeds(v)
     by = {(r["source"], r["controller"], r["trajectory"], r["payload_g"], r["orientation"]): r for r in rows}
     for c in ("ffpva", "smc"):
         heavy = by.get(("chapter 6 T1", c, 1, 13.5, "vertical"))
@@ -581,6 +689,14 @@ def report(v: Validation) -> str:
     for head, members in groups.items():
         lines.append(f"| {head} | {members[0]['plant']} | {sum(r['within_tolerance'] for r in members)} of "
                      f"{len(members)} |")
+    if v.seeds:
+        more = f"on {v.seeds[0]['groups'] * calibrate.THESIS_RUNS} more seeds ({v.seeds[0]['seeds']})"
+        sse = [r for r in v.seeds if r["sse_twin"] is not None]
+        lines.append(f"| chapter 5 experiment and chapter 6 T1, {more} | as-built | "
+                     f"{sum(r['within_tolerance'] for r in v.seeds)} of {len(v.seeds)} |")
+        if sse:
+            lines.append(f"| T1 SSE range, {more} | as-built | {sum(r['sse_within_tolerance'] for r in sse)} of "
+                         f"{len(sse)} |")
     lines += ["", "![twin against measurement](validation.png)", "", "## Why, as far as the twin shows", ""]
     lines += _why(v) + [""]
     if v.pulses and v.pulses["runs"]:
@@ -622,6 +738,27 @@ def report(v: Validation) -> str:
     table("T1 steady-error ranges, `as-built` plant (± max |SSE| of five runs)",
           groups.get("chapter 5 experiment, T1 SSE range", []) + groups.get("chapter 6 T1, T1 SSE range", []),
           f"Tolerance ±{SSE_TOLERANCE_DEG} deg.")
+    if v.seeds:
+        n = v.seeds[0]["groups"] * calibrate.THESIS_RUNS
+        lines += [f"## Five runs or {n}: the measured cells on seeds {v.seeds[0]['seeds']}", "",
+                  f"Every measured cell again on {n} noise seeds that no step of the calibration ran, in "
+                  f"{v.seeds[0]['groups']} groups of five. `groups within` counts the five-run groups within tolerance "
+                  f"({RMSE_TOLERANCE * 100:.0f} % of the RMSE mean, ±{SSE_TOLERANCE_DEG:g} deg of the SSE range). The measured "
+                  "mean's ± is its standard error (the thesis's std / sqrt 5). The summary above still judges "
+                  "seeds 0-4, the thesis's five runs.", "",
+                  f"| controller | T | payload | orientation | measured | seeds 0-4 | {n} runs (mean ± std) | "
+                  f"twin / measured | within | groups within (low-high) | SSE range: measured | seeds 0-4 | groups' "
+                  "mean (low-high) | groups within |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+        for r in v.seeds:
+            sse = (f"{_fmt(r['sse_measured'])} | {_fmt(r['sse_five_run'])} | {_fmt(r['sse_twin'])} "
+                   f"({_fmt(r['sse_group_low'])}-{_fmt(r['sse_group_high'])}) | {r['sse_groups_within']} of {r['groups']}"
+                   if r["sse_twin"] is not None else "| | |")
+            lines.append(f"| {CONTROLLER_LABELS[r['controller']]} | {r['trajectory']} | {r['payload_g']:g} g | "
+                         f"{r['orientation']} | {r['measured']:.2f} ± {r['measured_se']:.2f} | "
+                         f"{_fmt(r['five_run_mean'])} | {r['twin_mean']:.2f} ± {r['twin_std']:.2f} | {r['ratio']:.2f} | "
+                         f"{'yes' if r['within_tolerance'] else '**no**'} | {r['groups_within']} of {r['groups']} "
+                         f"({_fmt(r['group_low'])}-{_fmt(r['group_high'])}) | {sse} |")
+        lines += ["", "![each measured cell's five-run groups against the measurement](seeds.png)", ""]
     valve = groups.get("4.4.3 valve test", [])
     lines += ["## The valve test (§4.4.3) and the delays", "",
               "The physical solenoid valve, alone, in the replica of the thesis's rig.", "",
@@ -677,6 +814,42 @@ def figure_validation(rows: Sequence[dict], path: pathlib.Path) -> None:
     ax.legend(fontsize=8)
     ax.set_title("twin against the thesis: mean RMSE of five runs")
     fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def figure_seeds(v: Validation, path: pathlib.Path) -> None:
+    """Per measured cell: each five-run group's twin / measured, seeds 0-4's and the whole mean's; below,
+    the T1 steady-error range of each group against the measured one."""
+    rows = v.seeds or []
+    fig, (top, bottom) = plt.subplots(2, 1, figsize=(13, 7.0), constrained_layout=True,
+                                      gridspec_kw={"height_ratios": [3, 2]})
+    for ax, what, band, label in ((top, "ratio", (1 - RMSE_TOLERANCE, 1 + RMSE_TOLERANCE), "twin / measured (RMSE)"),
+                                  (bottom, "sse", (-SSE_TOLERANCE_DEG, SSE_TOLERANCE_DEG),
+                                   "twin - measured (deg), T1 SSE range")):
+        shown = [r for r in rows if what == "ratio" or r["sse_twin"] is not None]
+        for x, r in enumerate(shown):
+            if what == "ratio":
+                groups, five, whole = (np.array(r["group_values"]) / r["measured"], r["five_run_mean"] / r["measured"],
+                                       r["ratio"])
+            else:
+                groups = np.array(r["sse_group_values"]) - r["sse_measured"]
+                five = None if r["sse_five_run"] is None else r["sse_five_run"] - r["sse_measured"]
+                whole = r["sse_twin"] - r["sse_measured"]
+            ax.plot(np.full(len(groups), x), groups, "o", color="tab:blue", alpha=0.45, ms=4,
+                    label="a five-run group" if x == 0 else None)
+            if five is not None:
+                ax.plot(x, five, "x", color="k", ms=7, mew=1.5, label="seeds 0-4" if x == 0 else None)
+            ax.plot(x, whole, "D", color="tab:red", ms=5, label=f"seeds {r['seeds']}'s mean" if x == 0 else None)
+        ax.axhspan(*band, color="tab:green", alpha=0.2, lw=0, label="tolerance")
+        ax.axhline(1.0 if what == "ratio" else 0.0, color="k", lw=0.8)
+        ax.set_xticks(range(len(shown)), [f"{r['controller']}\nT{r['trajectory']}" + (
+            f"\n{r['payload_g']:g} g {r['orientation'][0].upper()}" if r["payload_g"] or r["orientation"] == "vertical"
+            else "") for r in shown], fontsize=7)
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3, axis="y")
+        ax.legend(fontsize=7, ncol=4)
+    top.set_title(f"the measured cells on seeds {rows[0]['seeds'] if rows else ''}, five runs at a time", fontsize=10)
+    fig.savefig(path, dpi=100)
     plt.close(fig)
 
 
@@ -748,7 +921,7 @@ class ValidateExperiment(Experiment):
 
         from twin.plants.as_built import ensemble_values
 
-        total = 6 + len(ensemble_values())
+        total = 7 + len(ensemble_values())
         with tqdm(total=total, desc="validate", unit="stage", file=sys.stderr) as bar:
             v = validate(workers=args.workers, progress=lambda: bar.update(1))
         within = sum(r["within_tolerance"] for r in v.rows)
@@ -764,17 +937,19 @@ class ValidateExperiment(Experiment):
         return Outcome(rows=v.rows, answer=answer, failed=v.failed, detail=v)
 
     def outputs(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
-        """``validation.csv``, ``prediction.csv``, ``validation.md`` and its three figures (the CLI's
-        :meth:`publish` makes them all or nothing)."""
+        """``validation.csv``, ``prediction.csv``, ``validation.md`` and its figures, and ``seeds.csv``
+        (:func:`seed_rows`) (the CLI's :meth:`publish` makes them all or nothing)."""
         v = outcome.detail
         paths = [out / "validation.csv", out / "prediction.csv", out / "validation.md", out / "validation.png",
-                 out / "prediction.png", out / "pulses.png"]
+                 out / "prediction.png", out / "pulses.png", out / "seeds.csv", out / "seeds.png"]
         write_csv(v.rows, VALIDATION_COLUMNS, paths[0])
         write_csv(v.prediction, PREDICTION_COLUMNS, paths[1])
         paths[2].write_text(report(v))
         figure_validation(v.rows, paths[3])
         figure_prediction(v, paths[4])
         figure_pulses(v, paths[5])
+        write_csv(v.seeds or [], SEED_COLUMNS, paths[6])
+        figure_seeds(v, paths[7])
         return paths
 
 
