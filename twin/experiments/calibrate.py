@@ -139,15 +139,19 @@ class CellResult:
         return spread(self.rmse_deg).mean
 
     @property
-    def sse_range(self) -> float:
-        """The thesis's "+-": the largest |SSE| of five runs. With more seeds, its mean over the runs
-        taken five at a time in seed order (the largest of twenty runs would overstate what five runs
-        show); a last group of fewer than five is left out. With fewer than five runs in all, the
-        largest of those (which understates a five-run range). Groups whose runs all end moving
-        (nan) are left out; nan if all do."""
+    def sse_ranges(self) -> list[float]:
+        """The thesis's "+-", the largest |SSE| of five runs, for each five runs in seed order; a last
+        group of fewer than five is left out. With fewer than five runs in all, the largest of those
+        (which understates a five-run range). Groups whose runs all end moving (nan) are left out."""
         groups = [self.sse_deg[i:i + THESIS_RUNS] for i in range(0, len(self.sse_deg), THESIS_RUNS)]
         whole = [g for g in groups if len(g) == THESIS_RUNS] or groups
-        ranges = [float(np.nanmax(np.abs(g))) for g in whole if not all(math.isnan(s) for s in g)]
+        return [float(np.nanmax(np.abs(g))) for g in whole if not all(math.isnan(s) for s in g)]
+
+    @property
+    def sse_range(self) -> float:
+        """The mean of :attr:`sse_ranges` (the largest of twenty runs would overstate what five runs
+        show); nan if every group ends moving."""
+        ranges = self.sse_ranges
         return float(np.mean(ranges)) if ranges else math.nan
 
 
