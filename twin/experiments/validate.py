@@ -666,8 +666,7 @@ def _why_effects(v: Validation) -> list[str]:
     if hidden:
         line += (f"; a level within {RMSE_TOLERANCE * 100:.0f} % on the same runs hides it on " + ", ".join(
             f"{CONTROLLER_LABELS[r['controller']]} {_effect_name(r)}" for r in hidden))
-    line += (". Where the twin shows too little of a payload's cost on T1, its T3 prediction's payload trend is "
-             "likely short too." if low else ".")
+    line += "."
     return [line]
 
 
