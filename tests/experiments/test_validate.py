@@ -351,8 +351,8 @@ def test_seed_rows_count_the_five_run_groups_within_tolerance():
     assert third["five_run_mean"] is None and third["twin_mean"] == pytest.approx(2.1)
 
 
-def _seed_report(**fake) -> tuple[validate.Validation, str]:
-    v = _fake(1.0, lag_within=True, stalled=0, **fake)
+def _seed_report(ffpva_t2: float = 2.1) -> tuple[validate.Validation, str]:
+    v = _fake(1.0, lag_within=True, stalled=0)
     v.rows.append(validate._row("chapter 5 experiment, T1 SSE range", "ffpva", 1, 0.0, "horizontal", "as-built", 0.77,
                                 0.27, None, False))
     ffpva, smc, steady, smc1 = (("ffpva", 1, 0.0, "horizontal"), ("smc", 2, 0.0, "horizontal"),
@@ -360,7 +360,7 @@ def _seed_report(**fake) -> tuple[validate.Validation, str]:
     fresh = [_cell(ffpva, [1.4] * 5 + [1.8] * 5 + [1.5] * 5,
                    [0.7] * 5 + [0.2] * 5 + [1.5] * 5),  # in on 2 of 3; SSE ranges 0.7, 0.2, 1.5: mean 0.8
              _cell(smc, [2.0] * 15, [math.nan] * 15, max_error=[40.0] + [3.0] * 14),  # out on all three
-             _cell(steady, [2.1] * 15, [math.nan] * 15),  # in on all three: listed nowhere
+             _cell(steady, [ffpva_t2] * 15, [math.nan] * 15),  # in on all three: listed nowhere
              _cell(smc1, [1.2] * 5 + [1.6] * 5 + [1.2] * 5, [0.1] * 15)]  # in on 2 of 3; no five-run cell
     five = [_cell(ffpva, [1.4] * 5, [0.5] * 5, first_seed=0), _cell(smc, [2.325] * 5, [math.nan] * 5, first_seed=0),
             _cell(steady, [2.0] * 5, [math.nan] * 5, first_seed=0)]
@@ -381,6 +381,11 @@ def test_report_says_which_misses_hold_on_every_five_run_draw():
     assert ("In on some five-run groups and out on others: FF + PVA T1 (seeds 0-4 x1.00, 15 runs x1.12, 2 of 3 groups "
             "within), sliding mode T1 (seeds 0-4 x–, 15 runs x1.12, 2 of 3 groups within).") in text
     assert "FF + PVA T2 (" not in text
+    # Measured sliding mode < FF + PVA on T1 (1.19 < 1.40) and T2 (1.55 < 2.08); twin 1.33 < 1.57 and 2.00 < 2.10.
+    assert "Controller order on the 15-run means (Chapter 5): right on 2 of 2 trajectories." in text
+    _, wrong = _seed_report(ffpva_t2=1.9)
+    assert ("Controller order on the 15-run means (Chapter 5): right on 1 of 2 trajectories; T2: twin FF + PVA < "
+            "sliding mode (1.90, 2.00).") in wrong
     assert ("T1 steady-error ranges: 1 of 2 within ±0.5 deg on the mean of the groups' ranges (on seeds 0-4: 0 of 1). "
             "The largest |SSE| of five runs is a rough measure: across one cell's groups it spreads over 0.65 deg "
             "(median over the cells; up to 1.30), against a tolerance band 1 deg wide.") in text

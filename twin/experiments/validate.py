@@ -619,6 +619,15 @@ def _why_seeds(v: Validation) -> list[str]:
                  + ", ".join(f"{_cell_name(r)} (seeds 0-4 x{_fmt(r['five_run_mean'] and r['five_run_mean'] / r['measured'])}, "
                              f"{r['runs']} runs x{r['ratio']:.2f}, {r['groups_within']} of {r['groups']} groups within)"
                              for r in split) + ".")
+    flat = [r for r in rows if r["payload_g"] == 0.0 and r["orientation"] == "horizontal"]
+    measured, twin = _order(flat, "measured"), _order(flat, "twin_mean")
+    if measured:
+        same = [t for t in measured if measured[t] == twin[t]]
+        line += (f" Controller order on the {runs}-run means (Chapter 5): right on {len(same)} of {len(measured)} "
+                 "trajectories" + "".join(f"; T{t}: twin {twin[t]} (" + ", ".join(
+                     f"{r['twin_mean']:.2f}" for r in sorted((r for r in flat if r["trajectory"] == t),
+                                                             key=lambda r: r["twin_mean"])) + ")"
+                     for t in measured if t not in same) + ".")
     sse = [r for r in rows if r["sse_twin"] is not None]
     if sse:
         widths = [r["sse_group_high"] - r["sse_group_low"] for r in sse]
