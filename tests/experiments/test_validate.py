@@ -340,6 +340,9 @@ def test_seed_rows_count_the_five_run_groups_within_tolerance():
     assert first["groups"] == 3 and first["groups_within"] == 2 and first["group_means"] == pytest.approx([1.4, 1.8, 1.2])
     assert (first["group_low"], first["group_high"]) == pytest.approx((1.2, 1.8))
     assert first["measured_se"] == pytest.approx(0.06 / math.sqrt(5))
+    assert (first["measured_std_low"], first["measured_std_high"]) == pytest.approx((0.06 * 0.6493, 0.06 * 2.3724),
+                                                                                    rel=1e-3)
+    assert second["spread_within"] is False  # ten runs of 2.0: std 0, below 0.25 * 0.649
     assert first["sse_group_ranges"] == pytest.approx([0.7, 0.2, 1.6]) and first["sse_groups_within"] == 1
     assert first["sse_twin"] == pytest.approx(2.5 / 3) and first["sse_within_tolerance"] is True
     assert (first["sse_group_low"], first["sse_group_high"]) == pytest.approx((0.2, 1.6))
@@ -380,7 +383,7 @@ def test_report_says_which_misses_hold_on_every_five_run_draw():
     assert "standard errors): sliding mode T2 (x1.29; +4.0)." in text  # (2.0 - 1.55) / (0.25 / sqrt 5)
     assert ("In on some five-run groups and out on others: FF + PVA T1 (seeds 0-4 x1.00, 15 runs x1.12, 2 of 3 groups "
             "within), sliding mode T1 (seeds 0-4 x–, 15 runs x1.12, 2 of 3 groups within).") in text
-    assert "FF + PVA T2 (" not in text
+    assert "FF + PVA T2 (seeds 0-4" not in text  # in on every group: not among the split cells
     # Measured sliding mode < FF + PVA on T1 (1.19 < 1.40) and T2 (1.55 < 2.08); twin 1.33 < 1.57 and 2.00 < 2.10.
     assert "Controller order on the 15-run means (Chapter 5): right on 2 of 2 trajectories." in text
     _, wrong = _seed_report(ffpva_t2=1.9)
@@ -390,9 +393,15 @@ def test_report_says_which_misses_hold_on_every_five_run_draw():
             "The largest |SSE| of five runs is a rough measure: across one cell's groups it spreads over 0.65 deg "
             "(median over the cells; up to 1.30), against a tolerance band 1 deg wide.") in text
     assert "the thesis's std / sqrt 5 is 2-7 % of them. 1 of these runs stalled (an error past 30 deg)" in text
-    assert ("| FF + PVA | 1 | 0 g | horizontal | 1.40 ± 0.03 | 1.40 | 1.57 ± 0.18 | 1.12 | yes | 2 of 3 (1.40-1.80) "
-            "| 0.77 | 0.50 | 0.80 (0.20-1.50) | 1 of 3 |") in text
-    assert "| sliding mode | 1 | 0 g | horizontal | 1.19 ± 0.05 | – | 1.33 ± 0.20 | 1.12 | yes | 2 of 3" in text
+    assert ("| FF + PVA | 1 | 0 g | horizontal | 1.40 ± 0.03 | 1.40 | 1.57 ± 0.18 | 0.06 (0.04-0.14) **out** | 1.12 | "
+            "yes | 2 of 3 (1.40-1.80) | 0.77 | 0.50 | 0.80 (0.20-1.50) | 1 of 3 |") in text
+    assert ("| sliding mode | 1 | 0 g | horizontal | 1.19 ± 0.05 | – | 1.33 ± 0.20 | 0.11 (0.07-0.26) | 1.12 | yes | "
+            "2 of 3") in text
+    # The rig's std from five runs: sigma in [s sqrt(4 / 9.488), s sqrt(4 / 0.711)] = [0.649 s, 2.372 s] at 90 %.
+    assert ("Run-to-run spread: the twin's std over its 15 runs lies in the 90 % interval of the rig's std that its "
+            "five runs allow on 1 of 4 cells; below it (the twin steadier than the rig) on sliding mode T2 (0.00 "
+            "against 0.25; 0.16-0.59), FF + PVA T2 (0.00 against 0.21; 0.14-0.50); above it on FF + PVA T1 (0.18 "
+            "against 0.06; 0.04-0.14).") in text
     assert "(seeds.png)" in text
 
 

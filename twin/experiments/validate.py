@@ -63,8 +63,10 @@ PREDICTION_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "t
 FRESH_GROUPS = 8
 _FIRST_FRESH_SEED = max(*calibrate.FIT_SEEDS, *(s for group in calibrate.NOISE_SEED_SETS for s in group)) + 1
 FRESH_SEEDS = tuple(range(_FIRST_FRESH_SEED, _FIRST_FRESH_SEED + FRESH_GROUPS * calibrate.THESIS_RUNS))
-SEED_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "measured", "measured_se", "seeds", "runs",
-                "stalled_runs", "five_run_mean", "twin_mean", "twin_std", "ratio", "within_tolerance", "groups_within",
+SPREAD_CONFIDENCE = 0.90  # the interval of the rig's run-to-run std that its five runs allow (chi-square, 4 dof)
+SEED_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "measured", "measured_se", "measured_std",
+                "measured_std_low", "measured_std_high", "seeds", "runs", "stalled_runs", "five_run_mean", "twin_mean",
+                "twin_std", "spread_within", "ratio", "within_tolerance", "groups_within",
                 "groups", "group_low", "group_high", "group_means", "sse_measured", "sse_five_run", "sse_twin",
                 "sse_within_tolerance", "sse_groups_within", "sse_group_low", "sse_group_high", "sse_group_ranges")
 EFFECT_COLUMNS = ("controller", "payload_g", "orientation", "measured_effect", "measured_se", "twin_effect", "twin_se",
@@ -120,9 +122,17 @@ def measured_rows(cells: Sequence[calibrate.CellResult]) -> list[dict]:
 def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.CellResult]) -> list[dict]:
     """Each measured cell on many seeds (``fresh``) beside its five runs (``five``, seeds 0-4; a cell not
     there gets none): the mean over all its runs and whether it is within tolerance, and how many of
-    its whole five-run groups are (groups with a nan run are left out); for T1 the same for the
-    steady-error range (:attr:`CellResult.sse_ranges`, and their mean)."""
+    its whole five-run groups are (groups with a nan run are left out); whether its std lies in the
+    interval of the rig's std that the thesis's five runs allow (:data:`SPREAD_CONFIDENCE`); for T1 the
+    same as the RMSE for the steady-error range (:attr:`CellResult.sse_ranges`, and their mean)."""
+    from scipy.stats import chi2
+
     five_of = {c.key: c for c in five}
+    dof = calibrate.THESIS_RUNS - 1
+    tail = (1 - SPREAD_CONFIDENCE) / 2
+    # A std s of n runs: (n - 1) s^2 / sigma^2 is chi-square with n - 1 dof, so sigma lies in
+    # [s sqrt(dof / chi2(1 - tail)), s sqrt(dof / chi2(tail))] at SPREAD_CONFIDENCE.
+    low, high = math.sqrt(dof / chi2.ppf(1 - tail, dof)), math.sqrt(dof / chi2.ppf(tail, dof))
     rows = []
     for cell in fresh:
         target = calibrate.TARGET_OF[cell.key]
@@ -137,10 +147,13 @@ def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.Ce
         mine = five_of.get(cell.key)
         row = {"controller": cell.controller, "trajectory": cell.trajectory, "payload_g": cell.payload_g,
                "orientation": cell.orientation, "measured": target.rmse_deg,
-               "measured_se": target.rmse_std_deg / math.sqrt(n),
+               "measured_se": target.rmse_std_deg / math.sqrt(n), "measured_std": target.rmse_std_deg,
+               "measured_std_low": target.rmse_std_deg * low, "measured_std_high": target.rmse_std_deg * high,
                "seeds": f"{min(cell.seeds)}-{max(cell.seeds)}" if cell.seeds else "", "runs": len(cell.rmse_deg),
                "stalled_runs": stalled_runs(cell), "five_run_mean": mine.mean_rmse if mine else None,
-               "twin_mean": s.mean, "twin_std": s.std, "ratio": s.mean / target.rmse_deg,
+               "twin_mean": s.mean, "twin_std": s.std,
+               "spread_within": target.rmse_std_deg * low <= s.std <= target.rmse_std_deg * high,
+               "ratio": s.mean / target.rmse_deg,
                "within_tolerance": within(s.mean), "groups_within": sum(within(m) for m in means),
                "groups": len(means), "group_low": min(means, default=None), "group_high": max(means, default=None),
                "group_means": means, "sse_measured": None, "sse_five_run": None, "sse_twin": None,
@@ -636,6 +649,18 @@ def _why_seeds(v: Validation) -> list[str]:
                  f"{sum(sse_verdict.values())} of {len(sse_verdict)}). The largest |SSE| of five runs is a rough "
                  f"measure: across one cell's groups it spreads over {float(np.median(widths)):.2f} deg (median over "
                  f"the cells; up to {max(widths):.2f}), against a tolerance band {2 * SSE_TOLERANCE_DEG:g} deg wide.")
+    narrow = [r for r in rows if r["twin_std"] < r["measured_std_low"]]
+    wide = [r for r in rows if r["twin_std"] > r["measured_std_high"]]
+
+    def spread(r: dict) -> str:
+        return (f"{_cell_name(r)} ({r['twin_std']:.2f} against {r['measured_std']:.2f}; "
+                f"{r['measured_std_low']:.2f}-{r['measured_std_high']:.2f})")
+
+    line += (f" Run-to-run spread: the twin's std over its {runs} runs lies in the {SPREAD_CONFIDENCE * 100:.0f} % "
+             f"interval of the rig's std that its five runs allow on {len(rows) - len(narrow) - len(wide)} of "
+             f"{len(rows)} cells" + ("; below it (the twin steadier than the rig) on " + ", ".join(map(spread, narrow))
+                                     if narrow else "")
+             + ("; above it on " + ", ".join(map(spread, wide)) if wide else "") + ".")
     line += (" The measured means carry their own five-run error: the thesis's std / sqrt 5 is "
              f"{_span([r['measured_se'] / r['measured'] for r in rows])} of them.")
     stalled = sum(r["stalled_runs"] for r in rows)
@@ -840,19 +865,24 @@ def report(v: Validation) -> str:
                   f"Every measured cell again on {n} noise seeds that no step of the calibration ran, in "
                   f"{v.seeds[0]['groups']} groups of five. `groups within` counts the five-run groups within tolerance "
                   f"({RMSE_TOLERANCE * 100:.0f} % of the RMSE mean, ±{SSE_TOLERANCE_DEG:g} deg of the SSE range). The measured "
-                  "mean's ± is its standard error (the thesis's std / sqrt 5). The SSE range on these runs is the "
+                  "mean's ± is its standard error (the thesis's std / sqrt 5). The measured std's interval is the "
+                  f"{SPREAD_CONFIDENCE * 100:.0f} % range of the rig's run-to-run std that five runs allow (chi-square, "
+                  "4 degrees of freedom); **out** marks a twin std outside it. The SSE range on these runs is the "
                   "mean of the groups' ranges. The verdicts in the summary's other rows judge seeds 0-4, the "
                   "thesis's five runs.", "",
                   f"| controller | T | payload | orientation | measured | seeds 0-4 | {n} runs (mean ± std) | "
+                  f"measured std ({SPREAD_CONFIDENCE * 100:.0f} % interval) | "
                   f"twin / measured | within | groups within (low-high) | SSE range: measured | seeds 0-4 | groups' "
-                  "mean (low-high) | groups within |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
+                  "mean (low-high) | groups within |", "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"]
         for r in v.seeds:
             sse = (f"{_fmt(r['sse_measured'])} | {_fmt(r['sse_five_run'])} | {_fmt(r['sse_twin'])} "
                    f"({_fmt(r['sse_group_low'])}-{_fmt(r['sse_group_high'])}) | {r['sse_groups_within']} of {r['groups']}"
                    if r["sse_twin"] is not None else "| | |")
             lines.append(f"| {CONTROLLER_LABELS[r['controller']]} | {r['trajectory']} | {r['payload_g']:g} g | "
                          f"{r['orientation']} | {r['measured']:.2f} ± {r['measured_se']:.2f} | "
-                         f"{_fmt(r['five_run_mean'])} | {r['twin_mean']:.2f} ± {r['twin_std']:.2f} | {r['ratio']:.2f} | "
+                         f"{_fmt(r['five_run_mean'])} | {r['twin_mean']:.2f} ± {r['twin_std']:.2f} | "
+                         f"{r['measured_std']:.2f} ({r['measured_std_low']:.2f}-{r['measured_std_high']:.2f})"
+                         f"{'' if r['spread_within'] else ' **out**'} | {r['ratio']:.2f} | "
                          f"{'yes' if r['within_tolerance'] else '**no**'} | {r['groups_within']} of {r['groups']} "
                          f"({_fmt(r['group_low'])}-{_fmt(r['group_high'])}) | {sse} |")
         lines += ["", "![each measured cell's five-run groups against the measurement](seeds.png)", ""]
