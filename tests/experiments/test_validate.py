@@ -436,16 +436,37 @@ def test_payload_effects_divide_by_the_same_controllers_0_g_flat_cell_with_their
 
 
 def test_report_says_where_the_twin_shows_too_little_of_a_payloads_cost():
+    """Made-up twin runs on every Chapter 6 T1 cell of FF + PVA, two of sliding mode's, and rows that make
+    no effect (PVA T1 flat, which has no payload cell; sliding mode T2). Three FF + PVA cells agree with
+    the rig, 0 g vertical is short by 2.6 s.e. while within 20 % of its level, 13.5 g vertical short by
+    7 s.e. and out of its level."""
     v = _fake(1.0, lag_within=True, stalled=0)
     assert "What a payload and the side cost" not in validate.report(v)
-    flat, heavy = ("ffpva", 1, 0.0, "horizontal"), ("ffpva", 1, 13.5, "vertical")
-    v.seeds = validate.seed_rows([_cell(flat, [1.4, 1.6] * 5, [0.1] * 10), _cell(heavy, [3.9, 4.1] * 5, [0.1] * 10)],
-                                 [])
-    # measured 4.55 / 1.40 = x3.25 +- 0.157; twin 4.0 / 1.5 = x2.67 +- 0.063 (std 0.105 of each, ten runs):
-    # 3.45 combined standard errors short
+    near, base, heavy = [1.65, 1.75], [1.35, 1.45], [2.95, 3.05]  # means 1.70, 1.40, 3.00; std 0.0527 over ten
+    cells = [(("ffpva", 1, 0.0, "horizontal"), base * 5), (("ffpva", 1, 6.5, "horizontal"), near * 10),
+             (("ffpva", 1, 13.5, "horizontal"), near * 5), (("ffpva", 1, 0.0, "vertical"), [1.30, 1.40] * 5),
+             (("ffpva", 1, 6.5, "vertical"), near * 5), (("ffpva", 1, 13.5, "vertical"), heavy * 5),
+             (("smc", 1, 0.0, "horizontal"), [1.15, 1.25] * 5), (("smc", 1, 13.5, "vertical"), [3.45, 3.55] * 5),
+             (("pva", 1, 0.0, "horizontal"), [1.8] * 5), (("smc", 2, 0.0, "horizontal"), [2.0] * 5)]
+    v.seeds = validate.seed_rows([_cell(key, runs, [0.1] * len(runs)) for key, runs in cells], [])
+    effects = {(r["controller"], r["payload_g"], r["orientation"]): r for r in v.effects}
+    assert sorted(effects) == sorted([("ffpva", 6.5, "horizontal"), ("ffpva", 13.5, "horizontal"),
+                                      ("ffpva", 0.0, "vertical"), ("ffpva", 6.5, "vertical"),
+                                      ("ffpva", 13.5, "vertical"), ("smc", 13.5, "vertical")])
+    for (c, g, o), r in effects.items():  # each over its own controller's 0 g flat cell
+        assert r["twin_effect"] == pytest.approx((3.5 / 1.2) if c == "smc" else (3.0 if g == 13.5 and o == "vertical"
+                                                 else 1.35 if g == 0.0 else 1.7) / 1.4)
+    # Twenty runs on 6.5 g flat (std 0.05 sqrt(20 / 19)) against ten on the base (std 0.05 sqrt(10 / 9)).
+    assert effects[("ffpva", 6.5, "horizontal")]["twin_se"] == pytest.approx(
+        1.7 / 1.4 * math.hypot(0.05 * math.sqrt(20 / 19) / math.sqrt(20) / 1.7, 0.05 * math.sqrt(10 / 9) / math.sqrt(10) / 1.4))
     text = validate.report(v)
-    assert "FF + PVA measured x3.25, twin x2.67 (13.5 g V)" in text
-    assert "smaller than the measured one by more than 2 combined standard errors on 1 of 1 cells, larger on 0" in text
-    assert "a level within 20 % on the same runs hides it on FF + PVA 13.5 g V" in text  # 4.0 / 4.55 = 0.88
-    assert "| FF + PVA | 13.5 g | vertical | x3.25 ± 0.16 | x2.67 ± 0.06 | -3.5 |" in text
+    assert ("smaller than the measured one by more than 2 combined standard errors (normal approximation) on 2 of 6 "
+            "cells, larger on 0; a level within 20 % on the same runs hides it on FF + PVA 0 g V.") in text
+    # 0 g vertical: measured 1.63 / 1.40 = x1.16 +- 0.074; twin 1.35 / 1.40 = x0.96 +- 0.017: -2.65 s.e.
+    assert "| FF + PVA | 0 g | vertical | x1.16 ± 0.07 | x0.96 ± 0.02 | -2.6 |" in text
+    # 13.5 g vertical: measured x3.25 +- 0.157; twin 3.0 / 1.4 = x2.14 +- 0.028: -6.96 s.e.
+    assert "| FF + PVA | 13.5 g | vertical | x3.25 ± 0.16 | x2.14 ± 0.03 | -7.0 |" in text
+    assert "FF + PVA measured x1.21 / x1.25 / x1.16 / x1.23 / x3.25, twin x1.21 / x1.21 / x0.96 / x1.21 / x2.14" in text
     assert "(effects.png)" in text
+
+

@@ -1,0 +1,31 @@
+"""The committed trial scripts whose printed numbers docs/as-built.md quotes: they still print them."""
+
+from __future__ import annotations
+
+import importlib.util
+import pathlib
+
+import pytest
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+
+
+def _load(name: str):
+    spec = importlib.util.spec_from_file_location(name, ROOT / "examples" / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.mark.slow  # about 25 s on 2 cores: twelve T1 cells, 40 seeds each
+def test_trial_payload_effect_prints_what_as_built_md_quotes(capsys):
+    _load("trial_payload_effect").main()
+    rows = {" ".join(line.split()[:4]): line.split() for line in capsys.readouterr().out.splitlines()[1:]}
+    # controller, grams, "g", orientation -> RMSE, move, hold 1.0-1.5 s, hold 1.5-3 s, ratios, error at 1.0 s
+    flat = rows["ffpva 0.0 g horizontal"]
+    assert flat[4:7] == ["1.64", "2.15", "2.27"] and flat[9:] == ["1.00", "-1.20", "±", "2.21"]
+    assert rows["ffpva 6.5 g horizontal"][4:7] == ["1.42", "2.28", "1.13"]
+    assert [rows[f"ffpva {k}"][9] for k in ("6.5 g horizontal", "13.5 g horizontal", "0.0 g vertical",
+                                             "6.5 g vertical", "13.5 g vertical")] == ["1.06", "1.19", "0.95", "1.15",
+                                                                                       "2.97"]
+    assert rows["ffpva 0.0 g vertical"][10:] == ["-1.09", "±", "1.19"]
