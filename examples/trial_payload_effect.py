@@ -30,7 +30,6 @@ WINDOWS = ((0.0, 1.0), (1.0, 1.5), (1.5, math.inf))  # the move, the hold's firs
 
 def main() -> None:
     plant = as_built_plant()
-    radius = plant.params.gears.spur_radius
     print("controller    payload  orientation   RMSE   move  hold 1.0-1.5 s  hold 1.5-3 s   RMSE / 0 g flat  "
           "move / 0 g flat  error at 1.0 s   (deg, seeds 40-79)")
     for controller in ("ffpva", "smc"):
@@ -39,7 +38,7 @@ def main() -> None:
             runs = run_many([Scenario(controller, 1, payload=grams * 1e-3, orientation=orientation, plant=plant, seed=s)
                              for s in SEEDS])
             t = runs[0].trace.time
-            error = np.array([np.degrees(r.trace.desired_angle - r.trace.measured_position / radius) for r in runs])
+            error = np.array([np.degrees(r.trace.desired_angle - r.scored_angle) for r in runs])
             rmse = float(np.mean([math.degrees(r.metrics.rmse) for r in runs]))
             window = [float(np.sqrt(np.mean(np.square(error[:, (t >= a) & (t < b)])))) for a, b in WINDOWS]
             base = base or (rmse, window[0])

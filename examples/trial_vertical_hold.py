@@ -37,7 +37,7 @@ def main() -> None:
         for orientation in (Orientation.HORIZONTAL, Orientation.VERTICAL):
             runs = run_many([Scenario("ffpva", 1, orientation=orientation, plant=variant, seed=s) for s in SEEDS])
             t = runs[0].trace.time
-            error = np.array([np.degrees(r.trace.desired_angle - r.trace.measured_position / radius) for r in runs])
+            error = np.array([np.degrees(r.trace.desired_angle - r.scored_angle) for r in runs])
 
             def rms(mask: np.ndarray, error: np.ndarray = error) -> float:
                 return float(np.sqrt(np.mean(error[:, mask] ** 2)))

@@ -31,7 +31,7 @@ def plot_run(result: Result, path: pathlib.Path) -> None:
     axes[1].plot(tr.time, deg(tr.desired_angle - tr.angle), "C3", lw=1.0, label="true")
     preset = result.scenario.preset
     if preset.metrics_on_sensor:  # the metrics score the Hall reading, as the thesis's experiments did
-        reading = tr.measured_position / preset.params.gears.spur_radius
+        reading = result.scored_angle
         axes[0].plot(tr.time, deg(reading), "C1", lw=0.8, alpha=0.8, label="Hall reading")
         axes[1].plot(tr.time, deg(tr.desired_angle - reading), "C1", lw=0.8, alpha=0.8, label="reading (scored)")
         axes[1].legend(loc="best", fontsize=8)

@@ -138,11 +138,11 @@ def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.Ce
     # A std s of n runs: (n - 1) s^2 / sigma^2 is chi-square with n - 1 dof, so sigma lies in
     # [s sqrt(dof / chi2(1 - tail)), s sqrt(dof / chi2(tail))] at SPREAD_CONFIDENCE.
     low, high = math.sqrt(dof / chi2.ppf(1 - tail, dof)), math.sqrt(dof / chi2.ppf(tail, dof))
+    n = calibrate.THESIS_RUNS
     rows = []
     for cell in fresh:
         target = calibrate.TARGET_OF[cell.key]
         s = spread(cell.rmse_deg)
-        n = calibrate.THESIS_RUNS
         groups = [cell.rmse_deg[i:i + n] for i in range(0, len(cell.rmse_deg) - n + 1, n)]
         means = [float(np.mean(g)) for g in groups if all(math.isfinite(x) for x in g)]
 
@@ -435,7 +435,7 @@ def pulse_cycle(committed: dict[str, float]) -> dict:
     out["example"] = {}  # controller -> T2's first run: time (s), error (deg), discharge open (bool), (T,) each
     for k, key in enumerate(keys):
         runs = results[k * len(SEEDS):(k + 1) * len(SEEDS)]
-        scored = [r.trace.measured_position / radius if plant.metrics_on_sensor else r.trace.angle for r in runs]
+        scored = [r.scored_angle for r in runs]
         opened = [r.trace.valve_open[:, 1] | r.trace.valve_open[:, 3] for r in runs]
         stats = [pulse_statistics(r.trace.time, r.trace.desired_angle, y, o)
                  for r, y, o in zip(runs, scored, opened, strict=True)]
@@ -593,22 +593,25 @@ def _why_pulses(pulses: dict | None, experiment: Sequence[dict]) -> list[str]:
     return [line]
 
 
+def _loaded(r: dict) -> bool:
+    """Whether a cell carries a payload or stands on its side (named after its trajectory), or is §8's flat 0 g."""
+    return bool(r["payload_g"]) or r["orientation"] == "vertical"
+
+
 def _cell_name(r: dict) -> str:
-    heavy = r["payload_g"] or r["orientation"] == "vertical"
     return (f"{CONTROLLER_LABELS[r['controller']]} T{r['trajectory']}"
-            + (f" {r['payload_g']:g} g {r['orientation']}" if heavy else ""))
+            + (f" {r['payload_g']:g} g {r['orientation']}" if _loaded(r) else ""))
 
 
 def _tick(r: dict) -> str:
     """A cell's short name under a figure's bar: controller, trajectory, and payload and orientation if any."""
-    heavy = r["payload_g"] or r["orientation"] == "vertical"
     return (f"{r['controller']}\nT{r['trajectory']}"
-            + (f"\n{r['payload_g']:g} g {r['orientation'][0].upper()}" if heavy else ""))
+            + (f"\n{r['payload_g']:g} g {r['orientation'][0].upper()}" if _loaded(r) else ""))
 
 
-def _span(values: Sequence[float], scale: float = 100.0, unit: str = " %") -> str:
-    low, high = min(values) * scale, max(values) * scale
-    return f"{low:.0f}{unit}" if round(low) == round(high) else f"{low:.0f}-{high:.0f}{unit}"
+def _percent_span(fractions: Sequence[float]) -> str:
+    low, high = min(fractions) * 100, max(fractions) * 100
+    return f"{low:.0f} %" if round(low) == round(high) else f"{low:.0f}-{high:.0f} %"
 
 
 def _why_seeds(v: Validation) -> list[str]:
@@ -657,17 +660,17 @@ def _why_seeds(v: Validation) -> list[str]:
     narrow = [r for r in rows if r["twin_std"] < r["measured_std_low"]]
     wide = [r for r in rows if r["twin_std"] > r["measured_std_high"]]
 
-    def spread(r: dict) -> str:
+    def stds(r: dict) -> str:
         return (f"{_cell_name(r)} ({r['twin_std']:.2f} against {r['measured_std']:.2f}; "
                 f"{r['measured_std_low']:.2f}-{r['measured_std_high']:.2f})")
 
     line += (f" Run-to-run spread: the twin's std over its {runs} runs lies in the {SPREAD_CONFIDENCE * 100:.0f} % "
              f"interval of the rig's std that its five runs allow on {sum(r['spread_within'] for r in rows)} of "
-             f"{len(rows)} cells" + ("; below it (the twin steadier than the rig) on " + ", ".join(map(spread, narrow))
+             f"{len(rows)} cells" + ("; below it (the twin steadier than the rig) on " + ", ".join(map(stds, narrow))
                                      if narrow else "")
-             + ("; above it on " + ", ".join(map(spread, wide)) if wide else "") + ".")
+             + ("; above it on " + ", ".join(map(stds, wide)) if wide else "") + ".")
     line += (" The measured means carry their own five-run error: the thesis's std / sqrt 5 is "
-             f"{_span([r['measured_se'] / r['measured'] for r in rows])} of them.")
+             f"{_percent_span([r['measured_se'] / r['measured'] for r in rows])} of them.")
     stalled = sum(r["stalled_runs"] for r in rows)
     if stalled:
         line += f" {stalled} of these runs stalled (an error past {STALL_ERROR_DEG:g} deg), counted in their means."
@@ -891,7 +894,8 @@ def report(v: Validation) -> str:
                          f"{'yes' if r['within_tolerance'] else '**no**'} | {r['groups_within']} of {r['groups']} "
                          f"({_fmt(r['group_low'])}-{_fmt(r['group_high'])}) | {sse} |")
         lines += ["", "![each measured cell's five-run groups against the measurement](seeds.png)", ""]
-    if v.effects:
+    effects = v.effects
+    if effects:
         lines += ["## What a payload and the side cost (Chapter 6 T1, against 0 g flat)", "",
                   "Each cell's RMSE over the same controller's 0 g horizontal RMSE, measured and on the twin's runs "
                   f"of seeds {v.seeds[0]['seeds']}, ± standard errors (the thesis's std / sqrt 5 for each measured "
@@ -902,7 +906,7 @@ def report(v: Validation) -> str:
                   f"A cell within {RMSE_TOLERANCE * 100:.0f} % of its "
                   "level need not show the payload's cost the rig showed; this table asks that.", "",
                   "| controller | payload | orientation | measured | twin | difference |", "|---|---|---|---|---|---|"]
-        for r in v.effects:
+        for r in effects:
             lines.append(f"| {CONTROLLER_LABELS[r['controller']]} | {r['payload_g']:g} g | {r['orientation']} | "
                          f"x{r['measured_effect']:.2f} ± {r['measured_se']:.2f} | x{r['twin_effect']:.2f} ± "
                          f"{r['twin_se']:.2f} | {r['difference_in_se']:+.1f} |")

@@ -57,6 +57,12 @@ class Trace:
     estimated_acceleration: np.ndarray  # m/s^2, the observer's a_hat
 
 
+def scored_angle(trace: Trace, preset: Plant) -> np.ndarray:
+    """rad, (T,): the angle the metrics score: on a plant that scores its sensor (``metrics_on_sensor``, as
+    the thesis's experiments did) the Hall reading over the spur's pitch radius, else the true output angle."""
+    return trace.measured_position / preset.params.gears.spur_radius if preset.metrics_on_sensor else trace.angle
+
+
 @dataclasses.dataclass(frozen=True)
 class Result:
     scenario: Scenario
@@ -64,6 +70,11 @@ class Result:
     metrics: Metrics
     warnings: tuple[str, ...]
     wall_time: float  # s, for the whole batch this run was part of
+
+    @property
+    def scored_angle(self) -> np.ndarray:
+        """rad, (T,): the angle this run's metrics score (:func:`scored_angle`)."""
+        return scored_angle(self.trace, self.scenario.preset)
 
 
 @functools.lru_cache(maxsize=64)
@@ -208,7 +219,7 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
             velocity=series["v"], estimated_velocity=series["vh"], estimated_acceleration=series["ah"],
         )
         tr_i = trajectories[i]
-        scored = series["ym"] / spur_radius[i] if plants[i].metrics_on_sensor else theta
+        scored = scored_angle(trace, plants[i])
         metrics = tracking_metrics(desired, scored, ends_at_rest=tr_i.ends_at_rest,
                                    rest_end_ticks=[int(round(e / h)) - 1 for e in tr_i.rest_ends()])
         results.append(Result(scenario=s, trace=trace, metrics=metrics, warnings=warnings, wall_time=wall))

@@ -20,6 +20,7 @@ from collections.abc import Sequence
 from twin.exceptions import InvalidScenario
 from twin.experiments.arguments import positive_int
 from twin.experiments.base import Experiment, Outcome
+from twin.experiments.validate import RMSE_TOLERANCE
 from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
 from twin.sim.metrics import spread
 from viz.figures import finish_panels, plt
@@ -27,7 +28,7 @@ from viz.figures import finish_panels, plt
 COLUMNS = ("controller", "phi_m_s", "source", "trajectory", "payload_g", "orientation", "rmse_mean_deg",
            "rmse_std_deg", "measured_deg", "ratio", "opening_lag_t2_deg")
 DEFAULT_PHIS = (0.1, 0.15, 0.2, 0.3)
-TOLERANCE = 0.20  # the bar for a measured cell
+TOLERANCE = RMSE_TOLERANCE  # a measured cell's bar, as `twin validate` judges it
 
 
 def measured_cells() -> list:
