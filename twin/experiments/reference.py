@@ -20,6 +20,10 @@ THESIS_EXPERIMENT_RMSE_DEG = {
 }
 # Experiment T1 steady-state error range (+-, deg) over the 5 runs (§8).
 THESIS_EXPERIMENT_SSE_T1_RANGE_DEG = {"pva": 0.41, "ffpva": 0.77, "smc": 0.85}
+# Experiment, the largest |error| (deg, §8's "max error" column), as the thesis rounds and gives it: one
+# number per controller and trajectory, not a mean over the runs. PVA + DZC on T1 only; FF + PVA 5 on
+# T1-T3 and 8 on T4; sliding mode 5 on T1 (after which it held within ±2.5).
+THESIS_EXPERIMENT_MAX_ERROR_DEG = {"pva": {1: 13.5}, "ffpva": {1: 5.0, 2: 5.0, 3: 5.0, 4: 8.0}, "smc": {1: 5.0}}
 
 # The robustness study's tip payloads (§9), g: none, then the thesis's two.
 THESIS_PAYLOADS_G = (0.0, *(round(m * 1e3, 9) for m in THESIS_PAYLOADS))
