@@ -41,3 +41,24 @@ def test_trial_pva_t1_prints_what_as_built_md_quotes(capsys):
     assert "SSE ranges ±5.48 / ±6.24 | T2 3.06 ± 0.16 (largest 9.3) | T3 3.11 ± 0.07" in lines["K_p 240,000 %/m"]
     assert lines["valve opens from 20 %"].startswith("T1 1.63 ± 0.10")
     assert lines["valve opens from 22 %"].startswith("T1 1.69 ± 0.07")
+
+
+@pytest.mark.slow  # about 4 min on 2 cores: 21 cells x 40 seeds three ways, then T1 and T3 with the noise scaled
+def test_trial_one_joint_prints_what_as_built_md_quotes(capsys):
+    _load("trial_one_joint").main()
+    out = capsys.readouterr().out
+    assert "std in the rig's 90 % interval: a map per run 11 of 21, a map per group 10 of 21, no map 11 of 21" in out
+    rows = {" ".join(line.split()[:5]): line.split()[8:] for line in out.splitlines() if line.startswith(("ffpva T1",
+                                                                                                         "smc T1"))}
+    # per way: ratio, pooled std, (in/out)
+    assert rows["ffpva T1 0 g horizontal"] == ["x1.17", "0.27", "(out)", "x1.18", "0.22", "(out)", "x1.17", "0.28",
+                                               "(out)"]
+    assert rows["smc T1 0 g horizontal"] == ["x1.23", "0.27", "(out)", "x1.23", "0.23", "(in)", "x1.26", "0.28",
+                                             "(out)"]
+    assert "noise x1: ffpva 1.64 ± 0.27, error at 1.0 s -1.20 ± 2.21 | smc 1.46 ± 0.27," in out
+    assert "noise x0.25: ffpva 2.06 ± 0.24, error at 1.0 s +2.58 ± 3.11 | smc 1.65 ± 0.39," in out
+    assert "noise x0.05: ffpva 2.23 ± 0.02, error at 1.0 s +4.49 ± 0.04 | smc 1.82 ± 0.53," in out
+    assert ("noise x0.5: ffpva T1 0 g H 1.82 | ffpva T3 0 g H 2.16 | ffpva T3 13.5 g V 3.50 | smc T1 0 g H 1.48 | "
+            "smc T3 0 g H 2.30 | smc T3 13.5 g V 3.43") in out
+    assert ("noise x1.73: ffpva T1 0 g H 1.49 | ffpva T3 0 g H 2.35 | ffpva T3 13.5 g V 3.65 | smc T1 0 g H 1.39 | "
+            "smc T3 0 g H 2.38 | smc T3 13.5 g V 3.55") in out
