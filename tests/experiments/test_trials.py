@@ -31,16 +31,22 @@ def test_trial_payload_effect_prints_what_as_built_md_quotes(capsys):
     assert rows["ffpva 0.0 g vertical"][10:] == ["-1.09", "±", "1.19"]
 
 
-@pytest.mark.slow  # about 12 s on 2 cores: PVA + DZC on T1-T3, ten seeds, six variants
+@pytest.mark.slow  # about 15 s on 2 cores: PVA + DZC on T1-T3, ten seeds, six variants; sliding mode T2, T3
 def test_trial_pva_t1_prints_what_as_built_md_quotes(capsys):
     _load("trial_pva_t1").main()
-    lines = {line[:28].strip(): line[28:].strip() for line in capsys.readouterr().out.splitlines()[1:]}
-    assert lines["K_p 80,000 %/m"].startswith("T1 1.83 ± 0.15 (largest 7.6) move 2.87 hold 0.96")
-    assert "SSE ranges ±0.35 / ±0.66 | T2 2.71 ± 0.12 (largest 6.3) | T3 2.91 ± 0.07" in lines["K_p 80,000 %/m"]
-    assert lines["K_p 240,000 %/m"].startswith("T1 3.51 ± 0.62 (largest 9.7) move 3.28 hold 3.69")
-    assert "SSE ranges ±5.48 / ±6.24 | T2 3.06 ± 0.16 (largest 9.3) | T3 3.11 ± 0.07" in lines["K_p 240,000 %/m"]
-    assert lines["valve opens from 20 %"].startswith("T1 1.63 ± 0.10")
-    assert lines["valve opens from 22 %"].startswith("T1 1.69 ± 0.07")
+    out = capsys.readouterr().out.splitlines()
+    split = next(i for i, line in enumerate(out) if line.startswith("sliding mode, seeds 0-9"))
+    pva = {line[:28].strip(): line[28:].strip() for line in out[1:split]}
+    smc = {line[:28].strip(): line[28:].strip() for line in out[split + 1:]}
+    assert pva["K_p 80,000 %/m"].startswith("T1 1.83 ± 0.15 (largest 7.6) move 2.87 hold 0.96")
+    assert "SSE ranges ±0.35 / ±0.66 | T2 2.71 ± 0.12 (largest 6.3) | T3 2.91 ± 0.07" in pva["K_p 80,000 %/m"]
+    assert pva["K_p 240,000 %/m"].startswith("T1 3.51 ± 0.62 (largest 9.7) move 3.28 hold 3.69")
+    assert "SSE ranges ±5.48 / ±6.24 | T2 3.06 ± 0.16 (largest 9.3) | T3 3.11 ± 0.07" in pva["K_p 240,000 %/m"]
+    assert "SSE ranges ±4.76 / ±1.31" in pva["K_p 160,000 %/m"]
+    assert pva["valve opens from 20 %"].startswith("T1 1.63 ± 0.10")
+    assert pva["valve opens from 22 %"].startswith("T1 1.69 ± 0.07")
+    assert smc == {"as committed": "T2 2.26 | T3 2.29", "valve opens from 20 %": "T2 2.16 | T3 2.19",
+                   "valve opens from 22 %": "T2 2.16 | T3 2.24"}
 
 
 @pytest.mark.slow  # about 4 min on 2 cores: 21 cells x 40 seeds three ways, then T1 and T3 with the noise scaled
