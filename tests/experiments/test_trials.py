@@ -36,13 +36,15 @@ def test_trial_pva_t1_prints_what_as_built_md_quotes(capsys):
     _load("trial_pva_t1").main()
     out = capsys.readouterr().out.splitlines()
     split = next(i for i, line in enumerate(out) if line.startswith("sliding mode, seeds 0-9"))
-    pva = {line[:28].strip(): line[28:].strip() for line in out[1:split]}
+    assert out[split - 1].endswith("as committed 0.000, opens from 20 % 0.072, opens from 22 % 0.054")
+    pva = {line[:28].strip(): line[28:].strip() for line in out[1:split - 1]}
     smc = {line[:28].strip(): line[28:].strip() for line in out[split + 1:]}
     assert pva["K_p 80,000 %/m"].startswith("T1 1.83 ± 0.15 (largest 7.6) move 2.87 hold 0.96")
     assert "SSE ranges ±0.35 / ±0.66 | T2 2.71 ± 0.12 (largest 6.3) | T3 2.91 ± 0.07" in pva["K_p 80,000 %/m"]
     assert pva["K_p 240,000 %/m"].startswith("T1 3.51 ± 0.62 (largest 9.7) move 3.28 hold 3.69")
     assert "SSE ranges ±5.48 / ±6.24 | T2 3.06 ± 0.16 (largest 9.3) | T3 3.11 ± 0.07" in pva["K_p 240,000 %/m"]
     assert "SSE ranges ±4.76 / ±1.31" in pva["K_p 160,000 %/m"]
+    assert "duty at openings 62 % (median)" in pva["K_p 80,000 %/m"]
     assert pva["valve opens from 20 %"].startswith("T1 1.63 ± 0.10")
     assert pva["valve opens from 22 %"].startswith("T1 1.69 ± 0.07")
     assert smc == {"as committed": "T2 2.26 | T3 2.29", "valve opens from 20 %": "T2 2.16 | T3 2.19",
@@ -66,5 +68,7 @@ def test_trial_one_joint_prints_what_as_built_md_quotes(capsys):
     assert "noise x0.05: ffpva 2.23 ± 0.02, error at 1.0 s +4.49 ± 0.04 | smc 1.82 ± 0.53," in out
     assert ("noise x0.5: ffpva T1 0 g H 1.82 | ffpva T3 0 g H 2.16 | ffpva T3 13.5 g V 3.50 | smc T1 0 g H 1.48 | "
             "smc T3 0 g H 2.30 | smc T3 13.5 g V 3.43") in out
+    assert ("noise x1: ffpva T1 0 g H 1.65 | ffpva T3 0 g H 2.21 | ffpva T3 13.5 g V 3.48 | smc T1 0 g H 1.43 | "
+            "smc T3 0 g H 2.30 | smc T3 13.5 g V 3.53") in out
     assert ("noise x1.73: ffpva T1 0 g H 1.49 | ffpva T3 0 g H 2.35 | ffpva T3 13.5 g V 3.65 | smc T1 0 g H 1.39 | "
             "smc T3 0 g H 2.38 | smc T3 13.5 g V 3.55") in out

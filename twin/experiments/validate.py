@@ -742,13 +742,14 @@ MISS_COLUMNS = ("comparison", "missed_on", "controller", "trajectory", "payload_
                 "off_by", "fresh", "fresh_within", "groups_within", "groups", "reading", "what_the_twin_shows")
 # How misses() reads a miss, in the order it tries the rules (the first that applies): the rule, then its name.
 READINGS = {
-    "draw": "the draw of five runs",  # out on seeds 0-4, in on the mean of the fresh seeds' runs
+    "draw": "the draw of five runs",  # out (or wrong) on seeds 0-4, in (or right) on the fresh seeds' runs
     "largest error": "§8's largest error is off the same way",  # a flat cell whose largest error is off by > 20 %
     "opening lag": "sliding mode's opening lag",  # sliding mode too high on a slow trajectory, opening no earlier
     "base level": "its 0 g flat level",  # a Chapter 6 cell: the payload's cost matches, its flat cell is out alike
     "scatter": "where the runs end scatters",  # an SSE range out on the fresh seeds too, their ends centred near 0
     "offset": "where the runs end is off zero",  # the same, their ends centred away from 0
     "follows": "follows from the cells that miss",  # an order that the measured values of its out cells restore
+    "failed": "runs that failed",  # a mean that is not a number: some run failed
     "open": "not shown by the twin",
 }
 
@@ -791,17 +792,23 @@ def misses(v: Validation) -> list[dict]:
         same = [x for x in experiment if x["controller"] == r["controller"] and x is not r and x["within_tolerance"]]
         flat = fresh.get((r["controller"], 1, 0.0, "horizontal"))
         cost = effect.get((r["controller"], r["payload_g"], r["orientation"]))
-        if not r["within_tolerance"] and f and f["within_tolerance"]:
+        fresh_only = r["within_tolerance"]
+        if not math.isfinite(miss["ratio"]):
+            reading, text = "failed", "some of its runs failed, so its mean is not a number"
+        elif not fresh_only and f and f["within_tolerance"]:
             below = sum(m > f["five_run_mean"] for m in f["group_means"]) if f["five_run_mean"] is not None else None
             reading, text = "draw", (f"x{f['ratio']:.2f} on the {f['runs']}-run mean, within; {f['groups_within']} of "
                                      f"{f['groups']} five-run groups within" + (
                                          f"; seeds 0-4 ({f['five_run_mean']:.2f}) lie below {below} of the "
                                          f"{f['groups']} groups' means" if below is not None else ""))
-        elif big and abs(big["ratio"] - 1) > RMSE_TOLERANCE and high(big) == high(miss):
+        elif big and (peak := big["fresh_mean"] if fresh_only else big["twin_mean"]) is not None \
+                and abs(peak / big["measured"] - 1) > RMSE_TOLERANCE and (peak > big["measured"]) == high(miss):
             reading = "largest error"
-            text = (f"the rig's largest error was {big['measured']:g} deg, the twin's {big['twin_mean']:.1f} (mean "
-                    f"over its runs; {big['twin_high']:.1f} at most): the "
-                    + ("rig" if not high(big) else "twin") + " reached a larger error; when in the run, and why, "
+            twin_largest = (f"{peak:.1f} (mean over its runs on seeds {f['seeds']})" if fresh_only else
+                            f"{peak:.1f} (mean over its runs; {big['twin_high']:.1f} at most)")
+            text = (f"the rig's largest error was {big['measured']:g} deg, the twin's {twin_largest}: the "
+                    + ("twin" if peak > big["measured"] else "rig") + " reached a larger error; when in the run, "
+                    "and why, "
                     "the thesis's data do not show"
                     + (". The same law is within on " + ", ".join(f"T{x['trajectory']}" for x in same)
                        if same else "")
@@ -815,12 +822,12 @@ def misses(v: Validation) -> list[dict]:
                 f"{lag['ffpva']:.2f} (closed form on T2's ramp, the slow trajectories' measure): no lead on slow "
                 f"motion, where the rig's sliding mode tracked at {rig:.2f} of its FF + PVA. phi is the thesis's, "
                 "not fitted; `twin whatif smc-phi` runs others")
-        elif (cost and flat and _loaded(r) and abs(cost["difference_in_se"]) <= EFFECT_SIGNIFICANCE
-              and not flat["within_tolerance"] and high(flat) == high(miss)):
+        elif (cost and flat and f and _loaded(r) and abs(cost["difference_in_se"]) <= EFFECT_SIGNIFICANCE
+              and not flat["within_tolerance"] and not f["within_tolerance"] and high(flat) == high(f) == high(miss)):
             reading, text = "base level", (
-                f"on seeds {flat['seeds']} the payload's cost matches the rig's (x{cost['twin_effect']:.2f} against "
-                f"x{cost['measured_effect']:.2f}) and its controller's 0 g flat cell is out the same way "
-                f"(x{flat['ratio']:.2f})" + ("" if flat["five_run_mean"] is None else
+                f"on seeds {flat['seeds']}, where this cell is x{f['ratio']:.2f}, the payload's cost matches the "
+                f"rig's (x{cost['twin_effect']:.2f} against x{cost['measured_effect']:.2f}) and its controller's 0 g "
+                f"flat cell is out the same way (x{flat['ratio']:.2f})" + ("" if flat["five_run_mean"] is None else
                                               f"; on seeds 0-4 that flat cell is x"
                                               f"{flat['five_run_mean'] / flat['measured']:.2f}"))
         else:
@@ -843,35 +850,39 @@ def misses(v: Validation) -> list[dict]:
             cost = effect.get((r["controller"], r["payload_g"], r["orientation"]))
             centred = abs(f["sse_mean"]) < f["sse_std"] / 2
             reading = "scatter" if centred else "offset"
-            text = (f"out on seeds {f['seeds']}" + (" too" if not r["within_tolerance"] else "")
-                    + f" (groups' ranges ±{f['sse_group_low']:.2f}-"
-                    f"{f['sse_group_high']:.2f}, mean ±{f['sse_twin']:.2f}, against ±{r['measured']:.2f}). The twin's "
-                    f"runs end at {f['sse_mean']:+.2f} ± {f['sse_std']:.2f} deg (mean ± std), so its range is "
+            text = (f"out on seeds {f['seeds']}" + (" too" if not r["within_tolerance"] else "") + ", "
+                    + ("narrower" if f["sse_twin"] < r["measured"] else "wider") + " than the rig's (groups' ranges "
+                    f"±{f['sse_group_low']:.2f}-{f['sse_group_high']:.2f}, mean ±{f['sse_twin']:.2f}, against "
+                    f"±{r['measured']:.2f}). The twin's runs end at {f['sse_mean']:+.2f} ± {f['sse_std']:.2f} deg "
+                    "(mean ± std), so its range is "
                     + ("their scatter" if centred else "their offset as much as their scatter")
                     + "; whether the rig's was scatter or an offset, its range does not tell"
-                    + (f". This cell's payload cost on RMSE is short too (x{cost['twin_effect']:.2f} against "
-                       f"x{cost['measured_effect']:.2f})" if cost and cost["difference_in_se"] < -EFFECT_SIGNIFICANCE
-                       else ""))
+                    + (f". The same cell's payload cost on RMSE is short of the rig's (x{cost['twin_effect']:.2f} "
+                       f"against x{cost['measured_effect']:.2f})"
+                       if cost and cost["difference_in_se"] < -EFFECT_SIGNIFICANCE else ""))
         else:
             reading, text = "open", "none of the other checks explains it"
         add("T1 SSE range", "seeds 0-4" if not r["within_tolerance"] else f"seeds {f['seeds']} only", r,
             r["measured"], r["twin_mean"], off, f and f["sse_twin"], f and f["sse_within_tolerance"],
             f and f["sse_groups_within"], reading, text)
-    rig, twin = _order(experiment, "measured"), _order(experiment, "twin_mean")
+    finite = [r for r in experiment if r["twin_mean"] is not None and math.isfinite(r["twin_mean"])]
+    rig, twin = _order(finite, "measured"), _order(finite, "twin_mean")
     fresh_flat = [r for r in v.seeds or [] if r["payload_g"] == 0.0 and r["orientation"] == "horizontal"
                   and math.isfinite(r["twin_mean"])]
     fresh_order = _order(fresh_flat, "twin_mean") if fresh_flat else {}
     for t in rig:
         ran = {r["controller"] for r in fresh_flat if r["trajectory"] == t}
-        complete = t in fresh_order and ran == {r["controller"] for r in experiment if r["trajectory"] == t}
+        complete = t in fresh_order and ran == {r["controller"] for r in finite if r["trajectory"] == t}
         right = fresh_order[t] == rig[t] if complete else None
         if rig[t] == twin[t] and right is not False:
             continue
-        on = experiment if rig[t] != twin[t] else [r for r in fresh_flat if r["trajectory"] == t]
-        out_cells = [r for r in on if r["trajectory"] == t and not r["within_tolerance"]]
-        restored = _order([dict(r, twin_mean=r["measured"] if r in out_cells else r["twin_mean"]) for r in on
-                           if r["trajectory"] == t], "twin_mean").get(t)
-        if out_cells and restored == rig[t]:
+        on = [r for r in (finite if rig[t] != twin[t] else fresh_flat) if r["trajectory"] == t]
+        out_cells = [r for r in on if not r["within_tolerance"]]
+        restored = _order([dict(r, twin_mean=r["measured"] if r in out_cells else r["twin_mean"]) for r in on],
+                          "twin_mean").get(t)
+        if rig[t] != twin[t] and right:
+            reading, text = "draw", f"right on the {fresh_flat[0]['runs']}-run means"
+        elif out_cells and restored == rig[t]:
             reading = "follows"
             text = (", ".join(f"{_cell_name(r)} is out (x{r['ratio']:.2f})" for r in out_cells)
                     + "; with the measured values in their place the order is right")
@@ -1010,14 +1021,15 @@ def report(v: Validation) -> str:
                   "on seeds 0-4, the verdict's seeds, or only on the fresh seeds' runs. `fresh seeds` is the RMSE "
                   "ratio on the mean of their runs, the mean of their five-run groups' SSE ranges, or their order; "
                   "then whether within (or right), and the five-run groups within. The reading is the first of "
-                  "these rules that applies (`misses.csv` has the table): **the draw** when a miss on seeds 0-4 is "
-                  "within on the fresh seeds; **§8's largest error is off the same way** for a flat cell whose "
+                  "these rules that applies (`misses.csv` has the table): **runs that failed** for a mean that is "
+                  "not a number; **the draw** when a miss on seeds 0-4 is within (an order: right) on the fresh "
+                  "seeds; **§8's largest error is off the same way** for a flat cell whose "
                   f"largest error and the thesis's differ by more than {RMSE_TOLERANCE * 100:.0f} % in the "
-                  "direction of the miss; **sliding mode's opening lag** when sliding mode tracks a slow trajectory "
+                  "direction of the miss (on the seeds it misses on); **sliding mode's opening lag** when sliding mode tracks a slow trajectory "
                   "too badly while its closed-form lag is no more than 10 % shorter than FF + PVA's; **its 0 g flat "
-                  "level** for a Chapter 6 cell whose payload cost matches the rig's within "
-                  f"{EFFECT_SIGNIFICANCE:g} standard errors while its controller's 0 g flat cell is out the same "
-                  "way; **where the runs end scatters** (or **is off zero**) for an SSE range out on the fresh "
+                  "level** for a Chapter 6 cell out on the fresh seeds whose payload cost there matches the rig's "
+                  f"within {EFFECT_SIGNIFICANCE:g} standard errors while its controller's 0 g flat cell is out the "
+                  "same way; **where the runs end scatters** (or **is off zero**) for an SSE range out on the fresh "
                   "seeds too, by whether the twin's signed steady errors centre within half a std of zero; "
                   "**follows** for an order that the measured values of its out cells would put right; else "
                   "**not shown by the twin**. A reading links a miss to another check; it is not a proof of its "
