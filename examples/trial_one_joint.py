@@ -31,13 +31,13 @@ import dataclasses
 import math
 
 import numpy as np
-from scipy.stats import chi2
 
 from twin.envs.runner import run_many
 from twin.experiments.calibrate import TARGETS
+from twin.experiments.validate import spread_interval
 from twin.physics.model import Orientation
 from twin.physics.params import StictionMapParams
-from twin.plants.as_built import STICTION_SCATTER, as_built_params, calibrated_values
+from twin.plants.as_built import STICTION_SCATTER, as_built_plant
 from twin.plants.preset import Plant
 from twin.sim.scenario import Scenario
 
@@ -46,11 +46,15 @@ GROUP = 5
 WAYS = ("a map per run", "a map per group", "no map")
 
 
-def plant_with(stiction_map: StictionMapParams) -> Plant:
-    params, options = as_built_params(calibrated_values())
-    params = dataclasses.replace(params, stiction_map=stiction_map)
-    return Plant("as-built", params, options["valve_model"], options["gain_set"],
-                 metrics_on_sensor=options["metrics_on_sensor"])
+def plant_with(stiction_map: StictionMapParams | None = None, noise: float = 1.0) -> Plant:
+    """The committed as-built plant with ``stiction_map`` (None: its own) and its sensors' noise bounds
+    (Hall and pressure) scaled by ``noise``."""
+    plant = as_built_plant()
+    params = plant.params
+    sensors = dataclasses.replace(params.sensors, position_noise=params.sensors.position_noise * noise,
+                                  pressure_noise=params.sensors.pressure_noise * noise)
+    return dataclasses.replace(plant, params=dataclasses.replace(
+        params, sensors=sensors, stiction_map=stiction_map or params.stiction_map))
 
 
 def rmse_of(way: str) -> dict:
@@ -76,13 +80,9 @@ NOISE_SCALES = (1.0, 0.25, 0.05)
 
 def noise_check() -> None:
     """FF + PVA and sliding mode T1, 0 g flat, with the sensors' noise scaled."""
-    params, options = as_built_params(calibrated_values())
     print("T1, 0 g flat, seeds 40-79, the sensors' noise scaled: RMSE and error at 1.0 s, mean ± std (deg)")
     for scale in NOISE_SCALES:
-        sensors = dataclasses.replace(params.sensors, position_noise=params.sensors.position_noise * scale,
-                                      pressure_noise=params.sensors.pressure_noise * scale)
-        plant = Plant("as-built", dataclasses.replace(params, sensors=sensors), options["valve_model"],
-                      options["gain_set"], metrics_on_sensor=options["metrics_on_sensor"])
+        plant = plant_with(noise=scale)
         parts = []
         for controller in ("ffpva", "smc"):
             runs = run_many([Scenario(controller, 1, plant=plant, seed=s) for s in SEEDS])
@@ -101,13 +101,9 @@ PREDICTION_CELLS = ((1, 0.0, "horizontal"), (3, 0.0, "horizontal"), (3, 13.5, "v
 
 def prediction_noise() -> None:
     """T1 0 g flat and two blind T3 cells, both controllers, seeds 40-59, with the noise scaled."""
-    params, options = as_built_params(calibrated_values())
     print("seeds 40-59, the sensors' noise scaled: mean RMSE (deg)")
     for scale in PREDICTION_SCALES:
-        sensors = dataclasses.replace(params.sensors, position_noise=params.sensors.position_noise * scale,
-                                      pressure_noise=params.sensors.pressure_noise * scale)
-        plant = Plant("as-built", dataclasses.replace(params, sensors=sensors), options["valve_model"],
-                      options["gain_set"], metrics_on_sensor=options["metrics_on_sensor"])
+        plant = plant_with(noise=scale)
         parts = []
         for controller in ("ffpva", "smc"):
             for trajectory, grams, orientation in PREDICTION_CELLS:
@@ -119,8 +115,7 @@ def prediction_noise() -> None:
 
 
 def main() -> None:
-    dof = GROUP - 1
-    low, high = math.sqrt(dof / chi2.ppf(0.95, dof)), math.sqrt(dof / chi2.ppf(0.05, dof))
+    low, high = spread_interval()
     runs = {way: rmse_of(way) for way in WAYS}
     print("cell                                   measured       " + "  ".join(f"{w:>30s}" for w in WAYS))
     print(" " * 55 + "  ".join(f"{'mean/meas  std (in)':>30s}" for _ in WAYS))

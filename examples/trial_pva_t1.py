@@ -33,7 +33,7 @@ import math
 import numpy as np
 
 from twin.envs.runner import run_many
-from twin.plants.as_built import as_built_params, calibrated_values
+from twin.plants.as_built import as_built_plant
 from twin.plants.preset import Plant
 from twin.sim.scenario import Scenario
 
@@ -50,13 +50,13 @@ EARLIER_VALVES = {  # SolenoidParams from valve_fit with BELOW_DEAD_ZONE 20 / 22
 
 
 def plant_with(solenoid: dict | None = None) -> Plant:
-    params, options = as_built_params(calibrated_values())
-    if solenoid:
-        valves = params.valves
-        params = dataclasses.replace(params, valves=dataclasses.replace(
-            valves, solenoid=dataclasses.replace(valves.solenoid, **solenoid)))
-    return Plant("as-built", params, options["valve_model"], options["gain_set"],
-                 metrics_on_sensor=options["metrics_on_sensor"])
+    """The committed as-built plant, its solenoid valve's parameters replaced by ``solenoid``."""
+    plant = as_built_plant()
+    if not solenoid:
+        return plant
+    valves = plant.params.valves
+    return dataclasses.replace(plant, params=dataclasses.replace(plant.params, valves=dataclasses.replace(
+        valves, solenoid=dataclasses.replace(valves.solenoid, **solenoid))))
 
 
 def use_gain(position: float) -> None:
@@ -91,10 +91,13 @@ def report(label: str, plant: Plant) -> None:
 
 
 def _openings(valve_open: np.ndarray) -> np.ndarray:
-    """Ticks where either discharge valve (columns 1 and 3) starts to open."""
-    discharge = np.asarray(valve_open)[:, [1, 3]] > 0
-    start = discharge & ~np.vstack([discharge[:1] & False, discharge[:-1]])
-    return start.any(axis=1)
+    """A mask of the ticks where either discharge valve (V2, V4: columns 1 and 3) starts to open."""
+    from twin.experiments.validate import opening_starts
+
+    mask = np.zeros(len(valve_open), dtype=bool)
+    for column in (1, 3):
+        mask[opening_starts(np.asarray(valve_open)[:, column])] = True
+    return mask
 
 
 def four_ms_lift(solenoid_values: dict) -> float:
@@ -104,9 +107,7 @@ def four_ms_lift(solenoid_values: dict) -> float:
     from twin.physics.params import SolenoidParams
 
     params = dataclasses.replace(SolenoidParams(), **solenoid_values)
-    states, _ = solenoid.simulate(params, solenoid.coil_command(25.0, int(round(16e-3 / params.step))),
-                                  h=params.step, periods=3)
-    return float(states[:, 1].max())
+    return solenoid.largest_lift(params, 25.0, period=16e-3, h=params.step)
 
 
 def main() -> None:

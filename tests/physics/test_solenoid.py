@@ -36,6 +36,16 @@ def test_the_plunger_moves_once_the_magnetic_force_beats_the_preload():
     assert first_lift == pytest.approx(pull_in, abs=2 * H)
 
 
+def test_largest_lift_is_none_for_a_pulse_that_ends_before_pull_in_and_full_for_a_held_coil():
+    """Pull-in as above: a coil pulse that ends before it cannot move the plunger; one held on the
+    whole period lifts it to the travel stop."""
+    period = NOMINAL_PARAMS.valves.pwm_period
+    pull_in = -P.coil_time_constant_on * math.log(1 - (1 + P.gap_ratio) / math.sqrt(P.force_ratio))
+    assert solenoid.largest_lift(P, (pull_in - 2 * H) / period * 100, period=period, h=H) == 0.0
+    assert solenoid.largest_lift(P, (pull_in + 20 * H) / period * 100, period=period, h=H) > 0.0
+    assert solenoid.largest_lift(P, 100.0, period=period, h=H) == 1.0
+
+
 def test_held_open_it_passes_the_open_valve_flow_after_the_column_accelerates():
     """tau_I dq/dt = 1 - q with the valve open: q = 1 - exp(-t / tau_I) (implicit Euler, within 0.5 %)."""
     ticks = 3000

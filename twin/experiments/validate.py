@@ -124,20 +124,24 @@ def measured_rows(cells: Sequence[calibrate.CellResult]) -> list[dict]:
     return rows + sse_rows
 
 
+def spread_interval(runs: int = calibrate.THESIS_RUNS, confidence: float = SPREAD_CONFIDENCE) -> tuple[float, float]:
+    """(low, high): the interval of the true std that a std s of ``runs`` runs allows at ``confidence``
+    is [low s, high s]. (n - 1) s^2 / sigma^2 is chi-square with n - 1 dof, so sigma lies in
+    [s sqrt(dof / chi2(1 - tail)), s sqrt(dof / chi2(tail))]."""
+    from scipy.stats import chi2
+
+    dof, tail = runs - 1, (1 - confidence) / 2
+    return math.sqrt(dof / chi2.ppf(1 - tail, dof)), math.sqrt(dof / chi2.ppf(tail, dof))
+
+
 def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.CellResult]) -> list[dict]:
     """Each measured cell on many seeds (``fresh``) beside its five runs (``five``, seeds 0-4; a cell not
     there gets none): the mean over all its runs and whether it is within tolerance, and how many of
     its whole five-run groups are (groups with a nan run are left out); whether its std lies in the
     interval of the rig's std that the thesis's five runs allow (:data:`SPREAD_CONFIDENCE`); for T1 the
     same as the RMSE for the steady-error range (:attr:`CellResult.sse_ranges`, and their mean)."""
-    from scipy.stats import chi2
-
     five_of = {c.key: c for c in five}
-    dof = calibrate.THESIS_RUNS - 1
-    tail = (1 - SPREAD_CONFIDENCE) / 2
-    # A std s of n runs: (n - 1) s^2 / sigma^2 is chi-square with n - 1 dof, so sigma lies in
-    # [s sqrt(dof / chi2(1 - tail)), s sqrt(dof / chi2(tail))] at SPREAD_CONFIDENCE.
-    low, high = math.sqrt(dof / chi2.ppf(1 - tail, dof)), math.sqrt(dof / chi2.ppf(tail, dof))
+    low, high = spread_interval()
     n = calibrate.THESIS_RUNS
     rows = []
     for cell in fresh:
@@ -754,122 +758,124 @@ READINGS = {
 }
 
 
+def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[dict]) -> tuple[str, str]:
+    """:data:`READINGS`' first rule that reads RMSE row ``r`` of ``v.rows`` (its fresh row ``f``, if
+    any), and its text."""
+    fresh_only = r["within_tolerance"]  # in on seeds 0-4, so out on the fresh seeds
+    miss = f if fresh_only else r  # the result that misses, and which way
+
+    def high(x: dict) -> bool:
+        return x["ratio"] > 1
+
+    big = None if _loaded(r) else next((x for x in v.max_errors or [] if (x["controller"], x["trajectory"])
+                                        == (r["controller"], r["trajectory"])), None)
+    peak = None if big is None else big["fresh_mean"] if fresh_only else big["twin_mean"]
+    cost = next((x for x in v.effects if (x["controller"], x["payload_g"], x["orientation"])
+                 == (r["controller"], r["payload_g"], r["orientation"])), None)
+    flat = next((x for x in v.seeds or [] if (x["controller"], x["trajectory"], x["payload_g"], x["orientation"])
+                 == (r["controller"], 1, 0.0, "horizontal")), None)
+    lag = (v.pulses or {}).get("lag_deg", {})
+    ffpva = next((x for x in experiment if (x["controller"], x["trajectory"]) == ("ffpva", r["trajectory"])), None)
+    if not math.isfinite(miss["ratio"]):
+        return "failed", "some of its runs failed, so its mean is not a number"
+    if not fresh_only and f and f["within_tolerance"]:
+        below = sum(m > f["five_run_mean"] for m in f["group_means"]) if f["five_run_mean"] is not None else None
+        return "draw", (f"x{f['ratio']:.2f} on the {f['runs']}-run mean, within; {f['groups_within']} of "
+                        f"{f['groups']} five-run groups within" + (
+                            f"; seeds 0-4 ({f['five_run_mean']:.2f}) lie below {below} of the {f['groups']} groups' "
+                            "means" if below is not None else ""))
+    if (peak is not None and abs(peak / big["measured"] - 1) > RMSE_TOLERANCE
+            and (peak > big["measured"]) == high(miss)):
+        same = [x for x in experiment if x["controller"] == r["controller"] and x is not r and x["within_tolerance"]]
+        twin_largest = (f"{peak:.1f} (mean over its runs on seeds {f['seeds']})" if fresh_only else
+                        f"{peak:.1f} (mean over its runs; {big['twin_high']:.1f} at most)")
+        return "largest error", (
+            f"the rig's largest error was {big['measured']:g} deg, the twin's {twin_largest}: the "
+            + ("twin" if peak > big["measured"] else "rig") + " reached a larger error; when in the run, and why, "
+            "the thesis's data do not show"
+            + (". The same law is within on " + ", ".join(f"T{x['trajectory']}" for x in same) if same else "")
+            + (f". The rig's runs also scattered more (std {f['measured_std']:.2f} against the twin's "
+               f"{f['twin_std']:.2f})" if f and f["twin_std"] < f["measured_std_low"] else ""))
+    if (r["controller"] == "smc" and r["trajectory"] in SLOW_TRAJECTORIES and high(miss) and "smc" in lag
+            and "ffpva" in lag and lag["smc"] >= 0.9 * lag["ffpva"] and ffpva):
+        return "opening lag", (
+            f"at the thesis's phi sliding mode opens its valve at {lag['smc']:.2f} deg of error and FF + PVA at "
+            f"{lag['ffpva']:.2f} (closed form on T2's ramp, the slow trajectories' measure): no lead on slow "
+            f"motion, where the rig's sliding mode tracked at {r['measured'] / ffpva['measured']:.2f} of its FF + "
+            "PVA. phi is the thesis's, not fitted; `twin whatif smc-phi` runs others")
+    if (cost and flat and f and _loaded(r) and abs(cost["difference_in_se"]) <= EFFECT_SIGNIFICANCE
+            and not flat["within_tolerance"] and not f["within_tolerance"] and high(flat) == high(f) == high(miss)):
+        return "base level", (
+            f"on seeds {flat['seeds']}, where this cell is x{f['ratio']:.2f}, the payload's cost matches the "
+            f"rig's (x{cost['twin_effect']:.2f} against x{cost['measured_effect']:.2f}) and its controller's 0 g "
+            f"flat cell is out the same way (x{flat['ratio']:.2f})"
+            + ("" if flat["five_run_mean"] is None else
+               f"; on seeds 0-4 that flat cell is x{flat['five_run_mean'] / flat['measured']:.2f}"))
+    return "open", "none of the other checks explains it"
+
+
+def _sse_reading(r: dict, f: dict | None, v: Validation) -> tuple[str, str]:
+    """:data:`READINGS`' first rule that reads T1 SSE range row ``r`` (its fresh row ``f``), and its text."""
+    judged = f is not None and f["sse_twin"] is not None
+    if not r["within_tolerance"] and judged and f["sse_within_tolerance"]:
+        return "draw", (f"±{f['sse_twin']:.2f} on the mean of the {f['groups']} groups' ranges, within; "
+                        f"{f['sse_groups_within']} of {f['groups']} groups within")
+    if not judged or f.get("sse_std") is None:
+        return "open", "none of the other checks explains it"
+    cost = next((x for x in v.effects if (x["controller"], x["payload_g"], x["orientation"])
+                 == (r["controller"], r["payload_g"], r["orientation"])), None)
+    centred = abs(f["sse_mean"]) < f["sse_std"] / 2
+    return ("scatter" if centred else "offset"), (
+        f"out on seeds {f['seeds']}" + (" too" if not r["within_tolerance"] else "") + ", "
+        + ("narrower" if f["sse_twin"] < r["measured"] else "wider") + " than the rig's (groups' ranges "
+        f"±{f['sse_group_low']:.2f}-{f['sse_group_high']:.2f}, mean ±{f['sse_twin']:.2f}, against "
+        f"±{r['measured']:.2f}). The twin's runs end at {f['sse_mean']:+.2f} ± {f['sse_std']:.2f} deg "
+        "(mean ± std), so its range is " + ("their scatter" if centred else "their offset as much as their scatter")
+        + "; whether the rig's was scatter or an offset, its range does not tell"
+        + (f". The same cell's payload cost on RMSE is short of the rig's (x{cost['twin_effect']:.2f} "
+           f"against x{cost['measured_effect']:.2f})" if cost and cost["difference_in_se"] < -EFFECT_SIGNIFICANCE
+           else ""))
+
+
 def misses(v: Validation) -> list[dict]:
     """Every comparison the issue's bar judges that misses (an RMSE mean out of 20 %, a T1 SSE range out
     of ±0.5 deg, a Chapter 5 trajectory's controller order wrong) on seeds 0-4, the verdict's seeds, or
     on the mean of the fresh seeds' runs only; its size, its fresh result, and what the other checks
     (:func:`seed_rows`, :func:`max_error_rows`, :func:`pulse_cycle`, :func:`payload_effects`) show about
-    it, read by :data:`READINGS`' rules. Added 2026-11-25 and its rules written after seeing every
-    result they read: a reading links a miss to another check, it does not prove a cause, and a miss
-    no rule reads says so."""
+    it, read by :data:`READINGS`' rules (:func:`_rmse_reading`, :func:`_sse_reading`, and here for the
+    orders). Added 2026-11-25 and its rules written after seeing every result they read: a reading links
+    a miss to another check, it does not prove a cause, and a miss no rule reads says so."""
     key = ("controller", "trajectory", "payload_g", "orientation")
     fresh = {tuple(r[k] for k in key): r for r in v.seeds or []}
-    largest = {(r["controller"], r["trajectory"]): r for r in v.max_errors or []}
-    effect = {(r["controller"], r["payload_g"], r["orientation"]): r for r in v.effects}
-    lag = (v.pulses or {}).get("lag_deg", {})
     experiment = [r for r in v.rows if r["source"] == "chapter 5 experiment"]
-    measured_of = {(r["controller"], r["trajectory"]): r["measured"] for r in experiment}
+    fresh_only = f"seeds {v.seeds[0]['seeds']} only" if v.seeds else ""
     out = []
 
-    def add(comparison, missed_on, r, measured, twin, off_by, f, within, groups_within, reading, text) -> None:
-        out.append({"comparison": comparison, "missed_on": missed_on, **{k: r.get(k) for k in key},
-                    "measured": measured, "twin": twin, "off_by": off_by, "fresh": f, "fresh_within": within,
-                    "groups_within": groups_within,
-                    "groups": (fresh.get(tuple(r.get(k) for k in key)) or {}).get("groups"), "reading": reading,
-                    "what_the_twin_shows": text})
-
-    def high(x: dict) -> bool:
-        return x["ratio"] > 1
+    def add(comparison, r, f, measured, twin, off_by, fresh_value, within, groups_within, reading, text) -> None:
+        out.append({"comparison": comparison, "missed_on": fresh_only if r.get("within_tolerance") else "seeds 0-4",
+                    **{k: r.get(k) for k in key}, "measured": measured, "twin": twin, "off_by": off_by,
+                    "fresh": fresh_value, "fresh_within": within, "groups_within": groups_within,
+                    "groups": (f or {}).get("groups"), "reading": reading, "what_the_twin_shows": text})
 
     for r in v.rows:
-        if r["source"] not in ("chapter 5 experiment", "chapter 6 T1"):
-            continue
         f = fresh.get(tuple(r[k] for k in key))
-        if r["within_tolerance"] and (f is None or f["within_tolerance"]):
-            continue
-        miss = r if not r["within_tolerance"] else f  # the result that misses, and which way
-        big = None if _loaded(r) else largest.get((r["controller"], r["trajectory"]))
-        same = [x for x in experiment if x["controller"] == r["controller"] and x is not r and x["within_tolerance"]]
-        flat = fresh.get((r["controller"], 1, 0.0, "horizontal"))
-        cost = effect.get((r["controller"], r["payload_g"], r["orientation"]))
-        fresh_only = r["within_tolerance"]
-        if not math.isfinite(miss["ratio"]):
-            reading, text = "failed", "some of its runs failed, so its mean is not a number"
-        elif not fresh_only and f and f["within_tolerance"]:
-            below = sum(m > f["five_run_mean"] for m in f["group_means"]) if f["five_run_mean"] is not None else None
-            reading, text = "draw", (f"x{f['ratio']:.2f} on the {f['runs']}-run mean, within; {f['groups_within']} of "
-                                     f"{f['groups']} five-run groups within" + (
-                                         f"; seeds 0-4 ({f['five_run_mean']:.2f}) lie below {below} of the "
-                                         f"{f['groups']} groups' means" if below is not None else ""))
-        elif big and (peak := big["fresh_mean"] if fresh_only else big["twin_mean"]) is not None \
-                and abs(peak / big["measured"] - 1) > RMSE_TOLERANCE and (peak > big["measured"]) == high(miss):
-            reading = "largest error"
-            twin_largest = (f"{peak:.1f} (mean over its runs on seeds {f['seeds']})" if fresh_only else
-                            f"{peak:.1f} (mean over its runs; {big['twin_high']:.1f} at most)")
-            text = (f"the rig's largest error was {big['measured']:g} deg, the twin's {twin_largest}: the "
-                    + ("twin" if peak > big["measured"] else "rig") + " reached a larger error; when in the run, "
-                    "and why, "
-                    "the thesis's data do not show"
-                    + (". The same law is within on " + ", ".join(f"T{x['trajectory']}" for x in same)
-                       if same else "")
-                    + (f". The rig's runs also scattered more (std {f['measured_std']:.2f} against the twin's "
-                       f"{f['twin_std']:.2f})" if f and f["twin_std"] < f["measured_std_low"] else ""))
-        elif (r["controller"] == "smc" and r["trajectory"] in SLOW_TRAJECTORIES and high(miss) and "smc" in lag
-              and "ffpva" in lag and lag["smc"] >= 0.9 * lag["ffpva"] and ("ffpva", r["trajectory"]) in measured_of):
-            rig = r["measured"] / measured_of[("ffpva", r["trajectory"])]
-            reading, text = "opening lag", (
-                f"at the thesis's phi sliding mode opens its valve at {lag['smc']:.2f} deg of error and FF + PVA at "
-                f"{lag['ffpva']:.2f} (closed form on T2's ramp, the slow trajectories' measure): no lead on slow "
-                f"motion, where the rig's sliding mode tracked at {rig:.2f} of its FF + PVA. phi is the thesis's, "
-                "not fitted; `twin whatif smc-phi` runs others")
-        elif (cost and flat and f and _loaded(r) and abs(cost["difference_in_se"]) <= EFFECT_SIGNIFICANCE
-              and not flat["within_tolerance"] and not f["within_tolerance"] and high(flat) == high(f) == high(miss)):
-            reading, text = "base level", (
-                f"on seeds {flat['seeds']}, where this cell is x{f['ratio']:.2f}, the payload's cost matches the "
-                f"rig's (x{cost['twin_effect']:.2f} against x{cost['measured_effect']:.2f}) and its controller's 0 g "
-                f"flat cell is out the same way (x{flat['ratio']:.2f})" + ("" if flat["five_run_mean"] is None else
-                                              f"; on seeds 0-4 that flat cell is x"
-                                              f"{flat['five_run_mean'] / flat['measured']:.2f}"))
-        else:
-            reading, text = "open", "none of the other checks explains it"
-        add("RMSE", "seeds 0-4" if not r["within_tolerance"] else f"seeds {f['seeds']} only", r, r["measured"],
-            r["twin_mean"], r["ratio"], f and f["ratio"], f and f["within_tolerance"], f and f["groups_within"],
-            reading, text)
+        if r["source"] in ("chapter 5 experiment", "chapter 6 T1"):
+            if not r["within_tolerance"] or (f and not f["within_tolerance"]):
+                add("RMSE", r, f, r["measured"], r["twin_mean"], r["ratio"], f and f["ratio"],
+                    f and f["within_tolerance"], f and f["groups_within"], *_rmse_reading(r, f, v, experiment))
     for r in v.rows:
-        if not r["source"].endswith("T1 SSE range"):
-            continue
         f = fresh.get(tuple(r[k] for k in key))
         judged = f is not None and f["sse_twin"] is not None
-        if r["within_tolerance"] and (not judged or f["sse_within_tolerance"]):
-            continue
-        off = None if r["twin_mean"] is None else r["twin_mean"] - r["measured"]
-        if not r["within_tolerance"] and judged and f["sse_within_tolerance"]:
-            reading, text = "draw", (f"±{f['sse_twin']:.2f} on the mean of the {f['groups']} groups' ranges, within; "
-                                     f"{f['sse_groups_within']} of {f['groups']} groups within")
-        elif judged and f.get("sse_std") is not None:
-            cost = effect.get((r["controller"], r["payload_g"], r["orientation"]))
-            centred = abs(f["sse_mean"]) < f["sse_std"] / 2
-            reading = "scatter" if centred else "offset"
-            text = (f"out on seeds {f['seeds']}" + (" too" if not r["within_tolerance"] else "") + ", "
-                    + ("narrower" if f["sse_twin"] < r["measured"] else "wider") + " than the rig's (groups' ranges "
-                    f"±{f['sse_group_low']:.2f}-{f['sse_group_high']:.2f}, mean ±{f['sse_twin']:.2f}, against "
-                    f"±{r['measured']:.2f}). The twin's runs end at {f['sse_mean']:+.2f} ± {f['sse_std']:.2f} deg "
-                    "(mean ± std), so its range is "
-                    + ("their scatter" if centred else "their offset as much as their scatter")
-                    + "; whether the rig's was scatter or an offset, its range does not tell"
-                    + (f". The same cell's payload cost on RMSE is short of the rig's (x{cost['twin_effect']:.2f} "
-                       f"against x{cost['measured_effect']:.2f})"
-                       if cost and cost["difference_in_se"] < -EFFECT_SIGNIFICANCE else ""))
-        else:
-            reading, text = "open", "none of the other checks explains it"
-        add("T1 SSE range", "seeds 0-4" if not r["within_tolerance"] else f"seeds {f['seeds']} only", r,
-            r["measured"], r["twin_mean"], off, f and f["sse_twin"], f and f["sse_within_tolerance"],
-            f and f["sse_groups_within"], reading, text)
+        if r["source"].endswith("T1 SSE range") and (not r["within_tolerance"]
+                                                       or (judged and not f["sse_within_tolerance"])):
+            add("T1 SSE range", r, f, r["measured"], r["twin_mean"],
+                None if r["twin_mean"] is None else r["twin_mean"] - r["measured"], f and f["sse_twin"],
+                f and f["sse_within_tolerance"], f and f["sse_groups_within"], *_sse_reading(r, f, v))
     finite = [r for r in experiment if r["twin_mean"] is not None and math.isfinite(r["twin_mean"])]
     rig, twin = _order(finite, "measured"), _order(finite, "twin_mean")
     fresh_flat = [r for r in v.seeds or [] if r["payload_g"] == 0.0 and r["orientation"] == "horizontal"
                   and math.isfinite(r["twin_mean"])]
-    fresh_order = _order(fresh_flat, "twin_mean") if fresh_flat else {}
+    fresh_order = _order(fresh_flat, "twin_mean")
     for t in rig:
         ran = {r["controller"] for r in fresh_flat if r["trajectory"] == t}
         complete = t in fresh_order and ran == {r["controller"] for r in finite if r["trajectory"] == t}
@@ -892,10 +898,34 @@ def misses(v: Validation) -> list[dict]:
         else:
             reading = "open"
             text = f"every cell of T{t} is within {RMSE_TOLERANCE * 100:.0f} %: the order turns on differences inside it"
-        add("controller order", "seeds 0-4" if rig[t] != twin[t] else f"seeds {fresh_flat[0]['seeds']} only",
-            {"controller": None, "trajectory": t, "payload_g": 0.0, "orientation": "horizontal"},
-            rig[t], twin[t], None, fresh_order[t] if complete else None, right, None, reading, text)
+        order_row = {"controller": None, "trajectory": t, "payload_g": 0.0, "orientation": "horizontal",
+                     "within_tolerance": rig[t] == twin[t]}
+        add("controller order", order_row, None, rig[t], twin[t], None,
+            fresh_order[t] if complete else None, right, None, reading, text)
     return out
+
+
+def _miss_value(x, comparison: str) -> str:
+    """A :func:`misses` row's value as the report shows it: an RMSE, a ± range, or an order's string."""
+    if comparison == "RMSE":
+        return _fmt(x)
+    return x if isinstance(x, str) else "–" if x is None else f"±{x:.2f}"
+
+
+def _miss_row(m: dict) -> str:
+    """One :func:`misses` row as a line of the report's table."""
+    kind = m["comparison"]
+    cell = f"T{m['trajectory']}" if m["controller"] is None else _cell_name(m)
+    off = ("" if m["off_by"] is None else f"x{m['off_by']:.2f}" if kind == "RMSE" else f"{m['off_by']:+.3f} deg")
+    fresh = ""
+    if m["fresh"] is not None:
+        verdict = (("right" if m["fresh_within"] else "wrong") if kind == "controller order" else
+                   "within" if m["fresh_within"] else "out")
+        fresh = ((f"x{m['fresh']:.2f}" if kind == "RMSE" else _miss_value(m["fresh"], kind)) + f", {verdict}"
+                 + (f", {m['groups_within']} of {m['groups']} groups" if m["groups_within"] is not None else ""))
+    return (f"| {kind} | {m['missed_on']} | {cell} | {_miss_value(m['measured'], kind)} | "
+            f"{_miss_value(m['twin'], kind)} | {off} | {fresh} | {READINGS[m['reading']]} | "
+            f"{m['what_the_twin_shows']} |")
 
 
 def _why(v: Validation) -> list[str]:
@@ -1036,24 +1066,7 @@ def report(v: Validation) -> str:
                   "cause. The table and its rules were added on 2026-11-25, after every result they read.", "",
                   "| comparison | missed on | cell | measured | twin, seeds 0-4 | off by | fresh seeds | reading | "
                   "what the other checks show |", "|---|---|---|---|---|---|---|---|---|"]
-        for m in missed:
-            rmse = m["comparison"] == "RMSE"
-            sse = m["comparison"] == "T1 SSE range"
-            cell = (f"T{m['trajectory']}" if m["controller"] is None else _cell_name(m))
-
-            def value(x, rmse=rmse) -> str:  # an RMSE, a ± range, or an order's string
-                return _fmt(x) if rmse else x if isinstance(x, str) else "–" if x is None else f"±{x:.2f}"
-
-            off = (f"x{m['off_by']:.2f}" if rmse else f"{m['off_by']:+.3f} deg" if sse and m["off_by"] is not None
-                   else "")
-            fresh = ("" if m["fresh"] is None else
-                     (f"x{m['fresh']:.2f}" if rmse else value(m["fresh"]))
-                     + ((", right" if m["fresh_within"] else ", wrong") if m["comparison"] == "controller order" else
-                        ", within" if m["fresh_within"] else ", out")
-                     + (f", {m['groups_within']} of {m['groups']} groups" if m["groups_within"] is not None else ""))
-            lines.append(f"| {m['comparison']} | {m['missed_on']} | {cell} | {value(m['measured'])} | "
-                         f"{value(m['twin'])} | {off} | {fresh} | {READINGS[m['reading']]} | "
-                         f"{m['what_the_twin_shows']} |")
+        lines += [_miss_row(m) for m in missed]
         lines.append("")
     lines += ["## Why, as far as the twin shows", ""]
     lines += _why(v) + [""]

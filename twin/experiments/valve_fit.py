@@ -61,9 +61,7 @@ def cost(values: dict[str, float], *, verbose: bool = False) -> float:
         misfit.append(np.log(np.maximum(flows, 1e-9) / eq442_fraction(FIT_DUTIES)))
     misfit = np.concatenate(misfit) / np.sqrt(2.0)
     opening, closing = solenoid.delays(params, h=params.step)
-    ticks = int(round(period / params.step))
-    states, _ = solenoid.simulate(params, solenoid.coil_command(BELOW_DEAD_ZONE, ticks), h=params.step, periods=3)
-    lift = float(states[:, 1].max())
+    lift = solenoid.largest_lift(params, BELOW_DEAD_ZONE, period=period, h=params.step)
     total = (float(np.sum(misfit ** 2)) + ((opening - 5e-3) / DELAY_SCALE) ** 2
              + ((closing - 2e-3) / DELAY_SCALE) ** 2 + (lift / 0.01) ** 2)
     if verbose:

@@ -76,6 +76,14 @@ def mean_flow_fraction(params: SolenoidParams, duty: float, *, period: float, h:
     return float(states[:, 3].mean())
 
 
+def largest_lift(params: SolenoidParams, duty: float, *, period: float, h: float, periods: int = 3) -> float:
+    """The plunger's largest lift (a fraction of full travel) in the last of ``periods`` PWM periods of
+    ``duty`` %, from shut and at rest: 0 for a pulse too short to move it."""
+    ticks = int(round(period / h))
+    states, _ = simulate(params, coil_command(duty, ticks), h=h, periods=periods)
+    return float(states[:, 1].max())
+
+
 @numba.njit(cache=True, inline="always")
 def _step(s, i, x, v, h, rise, fall, force_ratio, gap_ratio, spring_ratio, omega, zeta):  # pragma: no cover
     """One step of coil and plunger (the module docstring's equations); returns (i, x, v)."""
