@@ -9,6 +9,7 @@ import pathlib
 import subprocess
 import sys
 
+import numpy as np
 import pytest
 
 from twin.experiments import validate
@@ -76,6 +77,7 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
         "chapter 5 experiment", "chapter 6 T1", "chapter 5 experiment, T1 SSE range", "chapter 6 T1, T1 SSE range"))
     assert sum(r["comparison"] != "controller order" and r["missed_on"] == "seeds 0-4" for r in missed) == out_of_bar
     assert "## Every miss against the bar" in report and "## Largest error" in report
+    assert "## Full-duty rack speed (§4.5.1; a check)" in report and "- **Full-duty speed**" in report
     for name in ("validation.png", "prediction.png", "pulses.png", "seeds.png", "effects.png"):
         assert (out / name).read_bytes().startswith(b"\x89PNG")
     assert not list(out.glob("*.tmp*"))
@@ -618,3 +620,75 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies():
     assert validate.misses(v)[-1]["fresh"] is None  # no fresh order from an incomplete set of controllers
     v.rows = [r for r in v.rows if r["source"] == "4.6 open-loop mean lag at reversals (ms)"]
     assert validate.misses(v) == [] and "## Every miss" not in validate.report(v)
+
+
+def test_window_speed_is_the_distance_over_the_time_between_the_passes_either_way():
+    time = np.arange(0.0, 1.0, 1e-3)
+    out = 2e-3 + 0.03 * time  # 30 mm/s from 2 mm
+    assert validate.window_speed(time, out, 5e-3, 11e-3) == pytest.approx(0.03, rel=1e-9)
+    back = 18e-3 - 0.05 * time
+    assert validate.window_speed(time, back, 11e-3, 5e-3) == pytest.approx(0.05, rel=1e-9)
+    assert math.isnan(validate.window_speed(time, out, 5e-3, 40e-3))  # never gets there
+    # a pass before the first sample does not count: starting past the mark, the first crossing is later
+    wobble = np.where(time < 0.1, 6e-3, 4e-3 + 0.02 * (time - 0.1))
+    assert validate.window_speed(time, wobble, 5e-3, 11e-3) == pytest.approx(0.02, rel=1e-6)
+
+
+def test_the_thesis_plants_full_duty_speed_is_eq_4_3_6s_steady_state():
+    """On the thesis plant (water incompressible, the averaged valve) a rack at 100 % duty moves at the
+    steady state of eq. 4.3.6: v(y) = (P A - F_c(y)) / (F_v + 2 R(100) A^2), supply and discharge valve both
+    at 100 % (its mass is too small to matter). Over the window the mean speed is the travel over the
+    integral of dy / v(y): a closed form, not the twin's own code path. Both ways alike (no CCW scale)."""
+    from scipy import integrate
+
+    from twin.physics import friction
+    from twin.plants.preset import THESIS_PARAMS as p
+
+    area, resistance = p.cylinder.bore_area, p.valves.resistance(100.0)
+    low, high = validate.FULL_DUTY_WINDOW
+    y = np.linspace(low, high, 20001)
+    for pressure, _, _ in validate.THESIS_FULL_DUTY_SPEEDS:
+        v = (pressure * area - friction.coulomb_force(p.friction, y, np.ones_like(y))) / (
+            p.friction.viscous + 2 * resistance * area**2)
+        expected = (high - low) / integrate.trapezoid(1.0 / v, y)
+        cw, ccw = validate.full_duty_speeds("thesis", pressure)
+        assert cw == pytest.approx(expected, rel=2e-3) and ccw == pytest.approx(expected, rel=2e-3)
+
+
+def test_report_sets_the_full_duty_speeds_beside_the_measured_range_both_ways():
+    rows = [{"pressure": 245e3, "measured": 0.03, "end": "slowest", "thesis": (0.035, 0.035),
+             "as-built": (0.034, 0.023), "ratio": 0.023 / 0.03, "as-built, no CCW scale": (0.034, 0.034)},
+            {"pressure": 575e3, "measured": 0.12, "end": "fastest", "thesis": (0.123, 0.123),
+             "as-built": (0.119, 0.111), "ratio": 0.119 / 0.12, "as-built, no CCW scale": (0.119, 0.119)}]
+    v = _fake(1.0, lag_within=True, stalled=0)
+    v.full_duty = rows
+    text = validate.report(v)
+    assert "## Full-duty rack speed (§4.5.1; a check)" in text
+    assert "| 245 | 30 (slowest) | 35 / 35 | 34 / 23 | 0.77 |" in text
+    assert "| 575 | 120 (fastest) | 123 / 123 | 119 / 111 | 0.99 |" in text
+    assert ("at 245 kPa the as-built rack's slowest way (CCW) runs at 23 mm/s against the measured slowest 30 "
+            "(x0.77, more than 20 % under), CW at 34") in text
+    assert "fastest way (CW) runs at 119 mm/s against the measured fastest 120 (x0.99, within 20 %)" in text
+    assert "breaks away from rest both ways" in text and "Its CCW way (towards 0 deg) is the slower" in text
+    assert "at 1 it runs CW / CCW at 34 / 34 mm/s at 245 kPa; 119 / 119 mm/s at 575 kPa." in text
+    # the other way round: a CW side slower, and a way that never crosses the window
+    rows[0]["as-built"], rows[0]["ratio"] = (0.026, math.nan), 0.0
+    rows[1]["as-built"] = (0.100, 0.119)
+    text = validate.report(v)
+    assert "slowest way (CCW) runs at 0 mm/s against the measured slowest 30 (x0.00, more than 20 % under)" in text
+    assert "| 245 | 30 (slowest) | 35 / 35 | 26 / – | 0.00 |" in text
+    assert "does **not** break away from rest both ways" in text and "Its CCW way" not in text
+    assert "fastest way (CCW) runs at 119 mm/s" in text
+    assert "## Full-duty rack speed" not in validate.report(_fake(1.0, lag_within=True, stalled=0))
+
+
+@pytest.mark.slow  # about 10 s on 2 cores
+def test_every_ensemble_member_breaks_away_both_ways_at_245_kpa_as_the_force_loss_runs_did():
+    """§4.5.1's physical bound, run rather than computed: from rest at 245 kPa with the pair at 100 %, the
+    committed preset and every member of the ensemble carry the rack across the whole window both ways (the
+    box's breakaway bound is what should make this so), and CCW is never faster than CW."""
+    from twin.plants.as_built import as_built_plant, ensemble_plants
+
+    for plant in (as_built_plant(), *ensemble_plants()):
+        cw, ccw = validate.full_duty_speeds(plant, validate.THESIS_FULL_DUTY_SPEEDS[0][0])
+        assert 0.0 < ccw <= cw < 0.1, (plant.name, cw, ccw)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from twin.physics.model import THESIS_PAYLOADS
+from twin.plants.as_built import BREAKAWAY_TEST_PRESSURE
 
 # Simulated RMSE per trajectory T1..T4 and SSE of T1 (§8, "Simulation").
 THESIS_SIMULATED_RMSE_DEG = {
@@ -24,6 +25,12 @@ THESIS_EXPERIMENT_SSE_T1_RANGE_DEG = {"pva": 0.41, "ffpva": 0.77, "smc": 0.85}
 # number per controller and trajectory, not a mean over the runs. PVA + DZC on T1 only; FF + PVA 5 on
 # T1-T3 and 8 on T4; sliding mode 5 on T1 (after which it held within ±2.5).
 THESIS_EXPERIMENT_MAX_ERROR_DEG = {"pva": {1: 13.5}, "ffpva": {1: 5.0, 2: 5.0, 3: 5.0, 4: 8.0}, "smc": {1: 5.0}}
+
+# The force-loss runs (§4.5.1): the joint started from rest with both valves of the pair at 100 % duty, both
+# ways, at supply pressures from 245 to 575 kPa, and its rack ran at 0.03 to 0.12 m/s (the range, given to a
+# digit or two). That the slowest came at the lowest pressure and the
+# fastest at the highest is *inferred*. (supply Pa gauge, rack speed m/s, which end of the range).
+THESIS_FULL_DUTY_SPEEDS = ((BREAKAWAY_TEST_PRESSURE, 0.03, "slowest"), (575e3, 0.12, "fastest"))
 
 # The robustness study's tip payloads (§9), g: none, then the thesis's two.
 THESIS_PAYLOADS_G = (0.0, *(round(m * 1e3, 9) for m in THESIS_PAYLOADS))

@@ -39,7 +39,12 @@ import numpy as np
 from twin.batch.tables import write_csv
 from twin.experiments import calibrate
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.reference import ROBUSTNESS_CELLS, THESIS_EXPERIMENT_MAX_ERROR_DEG, THESIS_SIMULATED_RMSE_DEG
+from twin.experiments.reference import (
+    ROBUSTNESS_CELLS,
+    THESIS_EXPERIMENT_MAX_ERROR_DEG,
+    THESIS_FULL_DUTY_SPEEDS,
+    THESIS_SIMULATED_RMSE_DEG,
+)
 from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import plt
@@ -252,6 +257,75 @@ def valve_rows() -> list[dict]:
     for what, twin, measured in (("opening", opening, 5e-3), ("closing", closing, 2e-3)):
         rows.append(_row(f"4.4.3 valve {what} delay (ms)", None, None, None, None, "solenoid valve", measured * 1e3,
                          twin * 1e3, None, abs(twin - measured) <= DELAY_TOLERANCE))
+    return rows
+
+FULL_DUTY_WINDOW = (5e-3, 11e-3)  # m of rack travel a full-duty run's speed is taken over: inside eq. 4.5.7's
+# 2-14.5 mm, and at least 2 mm from where each way starts (T1's start, 2.5 mm; the far stop, 20 mm)
+FULL_DUTY_TURN = 0.6  # s at 100 % one way (past the window's far end at 245 kPa), then 100 % the other
+FULL_DUTY_PLANTS = ("thesis", "as-built")
+
+
+def window_speed(time: np.ndarray, position: np.ndarray, start: float, end: float) -> float:
+    """The mean speed (m/s, >= 0) over the travel from ``start`` to ``end`` (m, either way): the distance
+    over the time between the first crossing of ``start`` and the next of ``end``, each from short of the
+    mark to it or past (linear between ticks); nan if it never gets there."""
+    way = 1.0 if end > start else -1.0
+    ahead = way * (np.asarray(position) - start), way * (np.asarray(position) - end)
+    times, after = [], 0
+    for distance, mark in zip(ahead, (start, end), strict=True):
+        crossed = np.flatnonzero((distance[:-1] < 0.0) & (distance[1:] >= 0.0)) + 1
+        crossed = crossed[crossed > after]
+        if not crossed.size:
+            return math.nan
+        after = i = int(crossed[0])
+        y0, y1 = position[i - 1], position[i]
+        times.append(time[i - 1] + (time[i] - time[i - 1]) * (mark - y0) / (y1 - y0))
+    return abs(end - start) / (times[1] - times[0])
+
+
+def full_duty_speeds(plant, pressure: float) -> tuple[float, float]:
+    """§4.5.1's force-loss run on ``plant`` (a preset's name or a Plant) at supply ``pressure`` (Pa gauge),
+    sensor noise off: from rest at T1's start, both valves of the pair at 100 % towards +y for
+    :data:`FULL_DUTY_TURN`, then 100 % back; the rack's mean speed (m/s) over :data:`FULL_DUTY_WINDOW` going
+    out (CW) and coming back (CCW, towards 0 deg)."""
+    from controllers.open_loop import OpenLoop
+    from twin.sim.scenario import Scenario
+    from twin.sim.simulation import simulate
+
+    scenario = Scenario(None, 1, plant=plant, noise=False, supply_pressure=pressure)
+    out_and_back = OpenLoop(schedule=lambda t: 100.0 if t < FULL_DUTY_TURN - 1e-9 else -100.0,
+                            tick=scenario.preset.timestep)
+    trace = simulate([scenario], controllers=[out_and_back])[0].trace
+    turn = int(np.searchsorted(trace.time, FULL_DUTY_TURN - 1e-9))
+    low, high = FULL_DUTY_WINDOW
+    return (window_speed(trace.time[:turn], trace.rack_position[:turn], low, high),
+            window_speed(trace.time[turn:], trace.rack_position[turn:], high, low))
+
+
+def _moved(speeds: Sequence[float]) -> tuple[float, ...]:
+    """Full-duty speeds with a way that never crossed the window (nan) as 0: it did not get there."""
+    return tuple(float(x) if math.isfinite(x) else 0.0 for x in speeds)
+
+
+def full_duty_rows() -> list[dict]:
+    """§4.5.1's measured rack speeds against the twin's (a check: the thesis gives only the range's two ends,
+    to a digit or two, and which pressure each came at is inferred). Per end of the range: the supply, the
+    measured speed, each of :data:`FULL_DUTY_PLANTS`' speeds both ways (m/s) and as-built's with its CCW Coulomb
+    scale at 1, and as-built's slowest (or fastest) way over the measured. Added 2026-11-26, after every other result of this report."""
+    from twin.plants.as_built import as_built_plant
+
+    built = as_built_plant()
+    without_ccw_scale = dataclasses.replace(built, params=dataclasses.replace(built.params, friction=dataclasses.replace(
+        built.params.friction, ccw_coulomb_scale=1.0)))
+    rows = []
+    for pressure, measured, end in THESIS_FULL_DUTY_SPEEDS:
+        row = {"pressure": pressure, "measured": measured, "end": end}
+        for name in FULL_DUTY_PLANTS:
+            row[name] = tuple(float(x) for x in full_duty_speeds(name, pressure))
+        row["as-built, no CCW scale"] = tuple(float(x) for x in full_duty_speeds(without_ccw_scale, pressure))
+        twin = (min if end == "slowest" else max)(_moved(row["as-built"]))
+        row["ratio"] = twin / measured
+        rows.append(row)
     return rows
 
 
@@ -523,6 +597,7 @@ class Validation:
     pulses: dict | None = None  # pulse_cycle
     seeds: list[dict] | None = None  # seed_rows on FRESH_SEEDS
     max_errors: list[dict] | None = None  # max_error_rows
+    full_duty: list[dict] | None = None  # full_duty_rows
 
     @property
     def effects(self) -> list[dict]:
@@ -532,7 +607,8 @@ class Validation:
 
 def validate(*, workers: int = 2, progress=None) -> Validation:
     """Every comparison, then the prediction; ``progress()`` after the simulations, the fitted cells, the
-    fresh seeds, the valve, the open loop, sliding mode's parts, the pulse cycle and each ensemble member."""
+    fresh seeds, the valve, the open loop, the full-duty runs, sliding mode's parts, the pulse cycle and each
+    ensemble member."""
     from twin.plants.as_built import calibrated_values
 
     step = progress or (lambda: None)
@@ -553,6 +629,8 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
         lag_rows, study = openloop_rows()
         rows += lag_rows
         step()
+        full_duty = full_duty_rows()
+        step()
         parts = sliding_mode_parts(committed)
         step()
         pulses = pulse_cycle(committed)
@@ -563,7 +641,7 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
     failed = sum(c.failed for c in (*cells, *fresh, *own)) + sum(len(run.warnings) > 0 for run in study.runs)
     return Validation(rows=rows, prediction=predicted, prediction_detail=detail, failed=failed,
                       stalled={c.key: stalled_runs(c) for c in cells}, sliding_mode=parts, pulses=pulses,
-                      seeds=seeds, max_errors=largest)
+                      seeds=seeds, max_errors=largest, full_duty=full_duty)
 
 
 def _fmt(value, spec=".2f") -> str:
@@ -928,6 +1006,34 @@ def _miss_row(m: dict) -> str:
             f"{m['what_the_twin_shows']} |")
 
 
+def _why_full_duty(rows: Sequence[dict] | None) -> list[str]:
+    """What §4.5.1's full-duty runs show: each end of the measured range against the twin's way that sets it."""
+    if not rows:
+        return []
+    parts = []
+    for r in rows:
+        speeds = dict(zip(("CW", "CCW"), _moved(r["as-built"]), strict=True))
+        way = (min if r["end"] == "slowest" else max)(speeds, key=speeds.get)
+        other = "CCW" if way == "CW" else "CW"
+        size = (f"within {RMSE_TOLERANCE:.0%}" if abs(r["ratio"] - 1) <= RMSE_TOLERANCE else
+                f"more than {RMSE_TOLERANCE:.0%} " + ("under" if r["ratio"] < 1 else "over")).replace("%", " %")
+        parts.append(f"at {r['pressure'] / 1e3:g} kPa the as-built rack's {r['end']} way ({way}) runs at "
+                     f"{speeds[way] * 1e3:.0f} mm/s against the measured {r['end']} {r['measured'] * 1e3:g} "
+                     f"(x{r['ratio']:.2f}, {size}), {other} at {speeds[other] * 1e3:.0f}; "
+                     "the thesis's model CW / CCW " + " / ".join(f"{x * 1e3:.0f}" for x in r["thesis"]))
+    moved = all(min(_moved(r["as-built"])) > 0 for r in rows)
+    ccw_slower = all(r["as-built"][1] < r["as-built"][0] for r in rows)
+    unscaled = [_moved(r["as-built, no CCW scale"]) for r in rows]
+    return ["- **Full-duty speed** (§4.5.1's force-loss runs; a check, which pressure each end of the measured "
+            "range came at is inferred): " + "; ".join(parts) + "."
+            + (" The as-built joint breaks away from rest both ways at each pressure, as the rig did." if moved else
+               " The as-built joint does **not** break away from rest both ways at each pressure; the rig did.")
+            + (" Its CCW way (towards 0 deg) is the slower: with its fitted CCW Coulomb scale (the thesis tracked "
+               "worse moving CCW) at 1 it runs CW / CCW at " + "; ".join(
+                   " / ".join(f"{x * 1e3:.0f}" for x in u) + f" mm/s at {r['pressure'] / 1e3:g} kPa"
+                   for u, r in zip(unscaled, rows, strict=True)) + "." if ccw_slower else "")]
+
+
 def _why(v: Validation) -> list[str]:
     """What the runs themselves show about the misses: computed, not written in advance."""
     rows = v.rows
@@ -981,6 +1087,7 @@ def _why(v: Validation) -> list[str]:
         lines.append(f"- **Open-loop lag**: the as-built twin reverses sooner ({lag[0]['twin_mean']:.0f} ms) than the "
                      f"thesis's model ({lag[0]['measured']:.0f} ms); the real joint reversed later than the model. "
                      "The twin's chambers build pressure faster than the real ones did.")
+    lines += _why_full_duty(v.full_duty)
     members = v.prediction_detail["members"]
     low, high = min(m["stiction"] for m in members), max(m["stiction"] for m in members)
     load_low, load_high = min(m["load_friction"] for m in members), max(m["load_friction"] for m in members)
@@ -1183,6 +1290,24 @@ def report(v: Validation) -> str:
                   f"{_fmt(r['twin_mean'], '.0f')} ms: the as-built twin "
                   + ("lags the model, as the real joint did." if r["within_tolerance"] else
                      "does **not** lag the model, unlike the real joint."), ""]
+    if v.full_duty:
+        low, high = (f"{x * 1e3:g}" for x in FULL_DUTY_WINDOW)
+        lines += ["## Full-duty rack speed (§4.5.1; a check)", "",
+                  "The force-loss runs started the joint from rest with both valves of the pair at 100 % duty, both "
+                  "ways, at supply pressures from 245 to 575 kPa; the rack ran at 0.03 to 0.12 m/s. The thesis gives "
+                  "only the range, to a digit or two; that its slowest end came at the lowest pressure and its "
+                  "fastest at the highest is inferred, so this is a check, not a verdict. The twin's run, sensor "
+                  f"noise off: from T1's start, 100 % out for {FULL_DUTY_TURN:g} s, then 100 % back; the speed is the "
+                  f"mean over the rack's travel from {low} to {high} mm each way (CCW is towards 0 deg). `as-built / "
+                  "measured` takes its slowest way at the low end, its fastest at the high end. Added 2026-11-26, "
+                  "after every other result of this report.", "",
+                  "| supply (kPa) | measured (mm/s) | thesis model, CW / CCW | as-built, CW / CCW | "
+                  "as-built / measured |", "|---|---|---|---|---|"]
+        for r in v.full_duty:
+            lines.append(f"| {r['pressure'] / 1e3:g} | {r['measured'] * 1e3:g} ({r['end']}) | "
+                         + " | ".join(" / ".join(_fmt(x * 1e3, '.0f') for x in r[name]) for name in FULL_DUTY_PLANTS)
+                         + f" | {_fmt(r['ratio'])} |")
+        lines.append("")
     d = v.prediction_detail
     lines += ["## Prediction: Chapter 6 T3 (blind)", "",
               f"The held-back T3 cells, predicted on the committed preset (five runs) and on each of the "
@@ -1348,7 +1473,7 @@ class ValidateExperiment(Experiment):
 
         from twin.plants.as_built import ensemble_values
 
-        total = 7 + len(ensemble_values())
+        total = 8 + len(ensemble_values())
         with tqdm(total=total, desc="validate", unit="stage", file=sys.stderr) as bar:
             v = validate(workers=args.workers, progress=lambda: bar.update(1))
         within = sum(r["within_tolerance"] for r in v.rows)
