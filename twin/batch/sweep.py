@@ -145,15 +145,15 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
 
 
 def run_forked(calls: Sequence[tuple[Callable, tuple]], workers: int, on_done: Callable) -> None:
-    """Each ``function(*arguments)`` of ``calls`` (module-level functions) on ``workers`` forked processes,
-    ``on_done(result)`` in the parent as each finishes. The kernels are compiled once before the fork;
+    """Each ``function(*arguments)`` of ``calls`` (module-level functions) on ``workers`` forked processes
+    (no more than there are calls), ``on_done(result)`` in the parent as each finishes. The kernels are compiled once before the fork;
     on Ctrl-C, SIGTERM or an error the queued calls are cancelled and the workers killed, not waited for."""
     import twin.envs.runner  # noqa: F401 - imported and compiled once here, inherited by every forked worker
     from twin.sim.plant_state import compile_kernels
 
     compile_kernels()
     context = multiprocessing.get_context("fork")
-    pool = concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=context,
+    pool = concurrent.futures.ProcessPoolExecutor(max_workers=max(1, min(workers, len(calls))), mp_context=context,
                                                   initializer=worker_setup)
     try:
         futures = [pool.submit(function, *arguments) for function, arguments in calls]

@@ -20,7 +20,7 @@ import argparse
 import sys
 
 from twin.cli import bench, calibrate, demo, experiments, run, sweep, validate, view
-from twin.cli.common import EXIT_USAGE, Parser
+from twin.cli.common import EXIT_INTERRUPTED, EXIT_USAGE, Parser
 from twin.exceptions import TwinError
 
 COMMANDS = (demo, bench, sweep, experiments, run, calibrate, validate, view)
@@ -35,9 +35,12 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
     try:
+        args = build_parser().parse_args(argv)
         return args.func(args)
+    except KeyboardInterrupt:  # Ctrl-C where a command has nothing of its own to say: one line, no traceback
+        print("twin: interrupted", file=sys.stderr)
+        return EXIT_INTERRUPTED
     except TwinError as error:
         print(f"twin: error: {error}", file=sys.stderr)
         return EXIT_USAGE

@@ -26,5 +26,5 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 def add_parser(sub) -> None:
     bench = sub.add_parser("bench", help="cost per simulated second, as ratios to bare mj_step")
     bench.add_argument("--batch", type=arguments.positive_int, default=100, help="runs in the batched case (default 100)")
-    bench.add_argument("--workers", type=arguments.positive_int, default=None, help="sweep workers (default: all cores)")
+    bench.add_argument("--workers", type=arguments.workers, default=None, help="sweep workers (default: all cores)")
     bench.set_defaults(func=_cmd_bench)

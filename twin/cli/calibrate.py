@@ -36,7 +36,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
 def add_parser(sub) -> None:
     cal = sub.add_parser("calibrate", help="fit the as-built plant to the thesis's measurements (SPEC §8, §9 T1)")
     cal.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="results folder (created)")
-    cal.add_argument("--workers", type=arguments.positive_int, default=max(1, min(os.cpu_count() or 1, 4)),
+    cal.add_argument("--workers", type=arguments.workers, default=max(1, min(os.cpu_count() or 1, 4)),
                      help="processes (default: the cores, at most 4)")
     cal.add_argument("--install", action="store_true",
                      help="also make the result the as-built preset (twin/data/as_built.json)")

@@ -16,6 +16,7 @@ from twin.plants.as_built import EFFECTS, as_built_plant
 from twin.sim.scenario import CONTROLLER_NAMES, Scenario
 
 EXIT_USAGE = 2
+EXIT_INTERRUPTED = 130  # 128 + SIGINT, as a shell reports Ctrl-C
 
 
 class Parser(argparse.ArgumentParser):

@@ -18,6 +18,6 @@ def add_parser(sub) -> None:
     demo = sub.add_parser("demo", help="reproduce the thesis's simulated controller comparison")
     demo.add_argument("--out", type=arguments.out_dir, default=pathlib.Path("twin-demo"),
                       help="output folder (created; default ./twin-demo)")
-    demo.add_argument("--seeds", type=arguments.positive_int, default=5, help="noise seeds per case (default 5)")
+    demo.add_argument("--seeds", type=arguments.seed_count, default=5, help="noise seeds per case (default 5)")
     demo.add_argument("--plots", action=argparse.BooleanOptionalAction, default=True)
     demo.set_defaults(func=_cmd_demo)

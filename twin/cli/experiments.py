@@ -4,10 +4,11 @@
 from __future__ import annotations
 
 import argparse
+import shutil
 import sys
 
 from twin.batch.lock import folder_lock
-from twin.cli.common import Parser
+from twin.cli.common import EXIT_INTERRUPTED, Parser
 from twin.experiments import arguments
 from twin.experiments.base import Experiment
 from twin.experiments.studies import STUDIES
@@ -15,19 +16,26 @@ from twin.experiments.whatifs import WHATIFS
 
 
 def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
-    """Exit 0, or 1 when some run failed, or 130 when interrupted (a resumable one keeps its runs)."""
+    """Exit 0, or 1 when some run failed, or 130 when interrupted (a resumable one keeps its runs). A folder
+    this command made is removed again when it stops without its results, unless it keeps finished runs."""
     experiment.check(args)  # bad input: a one-line error before anything is written
+    made = not args.out.exists()
     args.out.mkdir(exist_ok=True)
-    with folder_lock(args.out):  # one writer per folder
-        try:
-            outcome = experiment.run(args, args.out)
-        except KeyboardInterrupt:
-            if not experiment.resumable:
-                raise
-            print(f"interrupted: finished runs are kept in {args.out / 'results.sqlite'}; "
-                  "run the same command again to finish the rest", file=sys.stderr)
-            return 130
-        paths = experiment.publish(outcome, args.out)  # all of them or none
+    try:
+        with folder_lock(args.out):  # one writer per folder
+            try:
+                outcome = experiment.run(args, args.out)
+            except KeyboardInterrupt:
+                if not experiment.resumable:
+                    raise
+                print(f"interrupted: finished runs are kept in {experiment.store(args.out)}; "
+                      "run the same command again to finish the rest", file=sys.stderr)
+                return EXIT_INTERRUPTED
+            paths = experiment.publish(outcome, args.out)  # all of them or none
+    except BaseException as stop:
+        if made and not (experiment.resumable and isinstance(stop, KeyboardInterrupt)):
+            shutil.rmtree(args.out, ignore_errors=True)
+        raise
     print(outcome.answer)
     print(f"wrote {', '.join(str(p) for p in paths)}")
     return 1 if outcome.failed else 0

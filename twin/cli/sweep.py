@@ -8,6 +8,7 @@ import signal
 import sys
 
 from twin.batch.lock import folder_lock
+from twin.cli.common import EXIT_INTERRUPTED
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 
@@ -48,7 +49,7 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
         bar.close()
         print(f"interrupted: finished scenarios are kept in {args.out / 'results.sqlite'}; "
               "run the same command again to finish the rest", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
     finally:
         bar.close()
     tables.write_results(outcome.records, args.out)
@@ -73,7 +74,7 @@ def add_parser(sub) -> None:
                            help="comma list; numbers also start:stop:step; seeds also a-b")
     sweep.add_argument("--config", type=pathlib.Path, metavar="GRID.toml", help="axes from a TOML file")
     sweep.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="results folder (created)")
-    sweep.add_argument("--workers", type=arguments.positive_int, default=None,
+    sweep.add_argument("--workers", type=arguments.workers, default=None,
                        help="processes (default: all cores); with Ray, CPUs to size chunks for (default: the cluster's)")
     sweep.add_argument("--backend", choices=("local", "ray"), default="local")
     sweep.add_argument("--ray-address", default=None, help="Ray cluster address (default: RAY_ADDRESS or local)")

@@ -7,7 +7,7 @@ import signal
 import sys
 import time
 
-from twin.cli.common import add_scenario_arguments, compare_of, compare_settings, scenario_from
+from twin.cli.common import EXIT_INTERRUPTED, add_scenario_arguments, compare_of, compare_settings, scenario_from
 from twin.experiments import arguments
 
 
@@ -35,7 +35,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
             session.write_html(args.html)
         except KeyboardInterrupt:
             print("twin view: interrupted; no recording written", file=sys.stderr)
-            return 130
+            return EXIT_INTERRUPTED
         print(f"wrote {args.html}", flush=True)
     return 1 if viewer.failure else 0
 

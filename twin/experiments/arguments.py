@@ -8,23 +8,40 @@ import argparse
 import math
 import os
 import pathlib
+import tempfile
+
+from twin.sim.scenario import MAX_SEED
+
+MAX_SEEDS = 1000  # noise seeds per case a command takes (a what-if's cells times 1000 is already a day's work)
+MAX_WORKERS = 4 * (os.cpu_count() or 1)  # local processes a command may start: more only queue for the cores
 
 
 def writable_file(suffix: str):
     """An argparse type for an output file with ``suffix`` in an existing, writable folder."""
     def check(text: str) -> pathlib.Path:
         path = pathlib.Path(text)
-        if path.suffix.lower() != suffix:
-            raise argparse.ArgumentTypeError(f"{text!r} must end in {suffix}")
+        if path.suffix.lower() != suffix or not path.stem:
+            raise argparse.ArgumentTypeError(f"{text!r} must be a file name ending in {suffix}")
         if not path.parent.is_dir():
             raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} of {text!r} does not exist")
         if path.is_dir():
             raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
-        if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)):
+        if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)) \
+                or not _can_create_in(path.parent):
             raise argparse.ArgumentTypeError(f"cannot write {text!r}")
         return path
 
     return check
+
+
+def _can_create_in(folder: pathlib.Path) -> bool:
+    """Whether a file can be made in ``folder``, tried rather than asked: ``os.access`` says yes to root
+    for folders no one can write to (``/proc``), and an output is written only after the work."""
+    try:
+        with tempfile.TemporaryFile(dir=folder):
+            return True
+    except OSError:
+        return False
 
 
 def checked(kind: type, accept, requirement: str):
@@ -43,6 +60,8 @@ def checked(kind: type, accept, requirement: str):
 
 def out_dir(text: str) -> pathlib.Path:
     """An output folder: created later, so only its parent must exist."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("the output folder must be named, got ''")
     path = pathlib.Path(text)
     if not path.parent.exists():
         raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
@@ -53,8 +72,11 @@ def out_dir(text: str) -> pathlib.Path:
 
 grams = checked(float, lambda v: v >= 0, "payload must be a non-negative number of grams")
 kpa = checked(float, lambda v: 0 < v <= 700, "supply pressure must be in (0, 700] kPa (cylinder rating)")
-seed = checked(int, lambda v: v >= 0, "seed must be a non-negative integer")
+seed = checked(int, lambda v: 0 <= v <= MAX_SEED, "seed must be an integer from 0 to 2^63 - 1")
 positive_int = checked(int, lambda v: v >= 1, "expected a positive integer")
+seed_count = checked(int, lambda v: 1 <= v <= MAX_SEEDS, f"seeds per case must be an integer from 1 to {MAX_SEEDS}")
+workers = checked(int, lambda v: 1 <= v <= MAX_WORKERS,
+                  f"workers must be an integer from 1 to {MAX_WORKERS} (four per core)")
 port = checked(int, lambda v: 0 <= v <= 65535, "port must be an integer in [0, 65535]")
 speed = checked(float, lambda v: 0 < v <= 10, "speed must be in (0, 10] times real time")
 seconds = checked(float, lambda v: v > 0, "duration must be a positive number of seconds")

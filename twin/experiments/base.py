@@ -74,6 +74,10 @@ class Experiment:
         self.plot(outcome, png)
         return paths + [png]
 
+    def store(self, out: pathlib.Path) -> pathlib.Path:
+        """Where a :attr:`resumable` experiment keeps its finished runs in ``out``."""
+        return out / "results.sqlite"
+
     def kept(self, out: pathlib.Path) -> list[pathlib.Path]:
         """What :meth:`run` itself keeps in ``out`` to list among the files written (a resumable store)."""
         return []

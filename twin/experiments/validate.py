@@ -1458,7 +1458,7 @@ class ValidateExperiment(Experiment):
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
         from twin.experiments import arguments
 
-        parser.add_argument("--workers", type=arguments.positive_int, default=2, help="processes (default 2)")
+        parser.add_argument("--workers", type=arguments.workers, default=2, help="processes (default 2)")
 
     def check(self, args: argparse.Namespace) -> None:
         from twin.plants.as_built import calibrated_values, ensemble_values

@@ -14,6 +14,7 @@ CONTROLLER_NAMES = ("pva", "ffpva", "smc")
 CONTROLLER_LABELS = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}  # for tables and plots
 MODEL_BASED_CONTROLLERS = ("ffpva", "smc")  # the two with the feed-forward model (§6)
 TRAJECTORY_NUMBERS = (1, 2, 3, 4)
+MAX_SEED = 2**63 - 1  # the largest noise seed a run's results can be stored with (SQLite's INTEGER)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -47,8 +48,8 @@ class Scenario:
                 raise InvalidScenario(f"PWM period must be a whole number of {base.timestep * 1e3:g} ms ticks "
                                       f"between 4 and 100 ticks, got {self.pwm_period * 1e3:g} ms")
         preset = self.preset
-        if not isinstance(self.seed, numbers.Integral) or isinstance(self.seed, bool) or self.seed < 0:
-            raise InvalidScenario(f"seed must be a non-negative integer, got {self.seed!r}")
+        if not isinstance(self.seed, numbers.Integral) or isinstance(self.seed, bool) or not 0 <= self.seed <= MAX_SEED:
+            raise InvalidScenario(f"seed must be an integer from 0 to 2^63 - 1, got {self.seed!r}")
         if self.supply_pressure is not None:
             rated = preset.params.cylinder.rated_pressure
             if not math.isfinite(self.supply_pressure) or not 0 < self.supply_pressure <= rated:

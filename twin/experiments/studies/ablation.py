@@ -18,7 +18,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from twin.batch.tables import write_csv
-from twin.experiments.arguments import positive_int
+from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.calibrate import CHECK_SEEDS, EXPERIMENT_CELLS, Evaluator, cell_rows
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
@@ -110,8 +110,8 @@ class AblationExperiment(Experiment):
     help = "the as-built preset on SPEC §8's cells with each effect switched off in turn"
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
-        parser.add_argument("--seeds", type=positive_int, default=5, help="noise seeds per cell (default 5)")
-        parser.add_argument("--workers", type=positive_int, default=2, help="processes (default 2)")
+        parser.add_argument("--seeds", type=arguments.seed_count, default=5, help="noise seeds per cell (default 5)")
+        parser.add_argument("--workers", type=arguments.workers, default=2, help="processes (default 2)")
 
     def check(self, args: argparse.Namespace) -> None:
         calibrated_values()  # no committed preset: a one-line error before anything is written

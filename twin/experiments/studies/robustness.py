@@ -23,7 +23,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 from twin.batch.grid import GridPoint, expand
 from twin.batch.sweep import run_sweep
 from twin.batch.tables import summarise, write_csv
-from twin.experiments.arguments import positive_int
+from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import THESIS_PAYLOADS_G
 from twin.plants import ENSEMBLE_PREFIX, PLANTS, plant
@@ -259,8 +259,8 @@ class RobustnessStudyExperiment(Experiment):
     resumable = True
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
-        parser.add_argument("--seeds", type=positive_int, default=ROBUSTNESS_SEEDS, help="noise seeds per case (default 5)")
-        parser.add_argument("--workers", type=positive_int, default=None, help="processes (default: all cores)")
+        parser.add_argument("--seeds", type=arguments.seed_count, default=ROBUSTNESS_SEEDS, help="noise seeds per case (default 5)")
+        parser.add_argument("--workers", type=arguments.workers, default=None, help="processes (default: all cores)")
         parser.add_argument("--plant", default=None, metavar="NAME", help="default: as-built if present, else thesis")
         parser.add_argument("--no-ensemble", dest="ensemble", action="store_false",
                             help="as-built: skip the calibration ensemble's runs (no band in the summary)")
@@ -268,12 +268,13 @@ class RobustnessStudyExperiment(Experiment):
     def check(self, args: argparse.Namespace) -> None:
         args.plant = args.plant or default_plant("thesis")
         plant(args.plant)  # an unknown name is a one-line error before anything is written
+        args.ensemble = args.ensemble and args.plant == "as-built"
+        args.points = robustness_grid(plant_name=args.plant, seeds=args.seeds, ensemble=args.ensemble)  # too big too
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         from tqdm import tqdm
 
-        args.ensemble = args.ensemble and args.plant == "as-built"
-        points = robustness_grid(plant_name=args.plant, seeds=args.seeds, ensemble=args.ensemble)
+        points = args.points
         print(f"{len(points)} runs on the {args.plant} plant -> {out.resolve()}", file=sys.stderr)
         with tqdm(total=len(points), unit="run", file=sys.stderr, dynamic_ncols=True, desc="robustness") as bar:
             study = robustness_study(out=out, plant_name=args.plant, seeds=args.seeds, workers=args.workers,

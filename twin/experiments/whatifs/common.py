@@ -8,14 +8,14 @@ import sys
 
 from twin.batch import grid
 from twin.exceptions import InvalidScenario
-from twin.experiments.arguments import positive_int
+from twin.experiments.arguments import seed_count
 from twin.plants import PLANTS
 
 
 def add_common_arguments(parser: argparse.ArgumentParser, default_plant: str, *, seeds: bool = True) -> None:
     parser.add_argument("--plant", choices=sorted(PLANTS), default=default_plant, help=f"default {default_plant}")
     if seeds:
-        parser.add_argument("--seeds", type=positive_int, default=3, help="noise seeds per case (default 3)")
+        parser.add_argument("--seeds", type=seed_count, default=3, help="noise seeds per case (default 3)")
 
 
 def list_flag(args: argparse.Namespace, flag: str, attribute: str, axis: str) -> list:

@@ -78,9 +78,9 @@ def check_members(members: int | None) -> None:
 
 def add_ensemble_arguments(parser, *, seeds: int) -> None:
     """``--seeds`` and ``--members``, the flags every ensemble what-if has."""
-    from twin.experiments.arguments import positive_int
+    from twin.experiments.arguments import positive_int, seed_count
 
-    parser.add_argument("--seeds", type=positive_int, default=seeds,
+    parser.add_argument("--seeds", type=seed_count, default=seeds,
                         help=f"noise seeds per case and ensemble member (default {seeds})")
     parser.add_argument("--members", type=positive_int, default=None,
                         help="only the first N calibration ensemble members (default: all)")

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 from twin.batch.grid import expand
 from twin.batch.sweep import run_sweep
 from twin.batch.tables import summarise
-from twin.experiments.arguments import positive_int
+from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import add_common_arguments, list_flag, progress_bar
 from viz.sweep_plots import plot_summary
@@ -50,26 +50,30 @@ class PayloadWhatIf(Experiment):
     name = "payload"
     help = "tracking against tip payload, horizontal and vertical"
     default_plant = "thesis"
+    resumable = True
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
         add_common_arguments(parser, self.default_plant)
         parser.add_argument("--payloads", default="0:30:2.5", metavar="LIST", help="grams (default 0:30:2.5)")
         parser.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), default=1)
-        parser.add_argument("--workers", type=positive_int, default=None, help="processes (default: all cores)")
+        parser.add_argument("--workers", type=arguments.workers, default=None, help="processes (default: all cores)")
 
     def check(self, args: argparse.Namespace) -> None:
         args.payload_values = list_flag(args, "--payloads", "payloads", "payload")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
-        store = out / "payload-runs"
+        store = self.store(out)
         store.mkdir(exist_ok=True)
         with progress_bar(self.name) as bar:
             return payload_study(out=store, payloads_g=args.payload_values, trajectory=args.trajectory,
                                  seeds=args.seeds, plant_name=args.plant, workers=args.workers, bar=bar)
 
+    def store(self, out: pathlib.Path) -> pathlib.Path:
+        return out / "payload-runs"
+
     def kept(self, out: pathlib.Path) -> list[pathlib.Path]:
         """The sweep store the runs are kept in (resumable)."""
-        return [out / "payload-runs"]
+        return [self.store(out)]
 
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         plot_summary(outcome.rows, path)

@@ -33,12 +33,18 @@ DEFAULT_RATES_MS = (1, 2, 4, 8, 16)
 
 def parse_rates(text: str) -> tuple[int, ...]:
     """``--rates``: whole milliseconds from 1 to 64, comma-separated; 16 (the thesis's) is always run."""
+    parts = [part.strip() for part in text.split(",")]
     try:
-        rates = sorted({int(part) for part in text.split(",") if part.strip()})
+        if not all(parts):
+            raise ValueError(text)
+        rates = sorted({int(part) for part in parts})
     except ValueError:
         raise InvalidScenario(f"--rates: whole milliseconds separated by commas, got {text!r}") from None
     if not rates or not all(1 <= r <= 64 for r in rates):
         raise InvalidScenario(f"--rates: each update period must be 1-64 ms, got {text!r}")
+    if rates == [THESIS_UPDATE_MS]:
+        raise InvalidScenario(f"--rates: give a period other than the thesis's {THESIS_UPDATE_MS} ms, which is "
+                              f"always run, got {text!r}")
     return tuple(sorted(set(rates) | {THESIS_UPDATE_MS}))
 
 

@@ -18,7 +18,7 @@ import pathlib
 from collections.abc import Sequence
 
 from twin.exceptions import InvalidScenario
-from twin.experiments.arguments import positive_int
+from twin.experiments.arguments import seed_count
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.validate import RMSE_TOLERANCE
 from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
@@ -40,8 +40,11 @@ def measured_cells() -> list:
 
 def parse_phis(text: str) -> tuple[float, ...]:
     """``--phis``: boundary layers in m/s, comma-separated, each in (0, 10]; the plant's own phi is always run."""
+    parts = [part.strip() for part in text.split(",")]
     try:
-        values = {float(part) for part in text.split(",") if part.strip()}
+        if not all(parts):
+            raise ValueError(text)
+        values = {float(part) for part in parts}
     except ValueError:
         raise InvalidScenario(f"--phis: numbers in m/s separated by commas, got {text!r}") from None
     if not values or not all(math.isfinite(v) and 0 < v <= 10 for v in values):
@@ -177,7 +180,7 @@ class SmcPhiWhatIf(Experiment):
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
         add_common_arguments(parser, self.default_plant, seeds=False)
-        parser.add_argument("--seeds", type=positive_int, default=10, help="noise seeds per case (default 10)")
+        parser.add_argument("--seeds", type=seed_count, default=10, help="noise seeds per case (default 10)")
         parser.add_argument("--phis", default=",".join(f"{p:g}" for p in DEFAULT_PHIS), metavar="LIST",
                             help="boundary layers in m/s (default 0.1,0.15,0.2,0.3; the thesis's 0.3 always runs)")
 
