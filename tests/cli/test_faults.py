@@ -522,3 +522,21 @@ def test_ctrl_c_while_the_command_line_loads_is_one_line(tmp_path):
             "sys.exit(entry())\n")
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert proc.returncode == 130 and proc.stderr.strip() == "twin: interrupted", proc.stderr
+
+
+def test_a_resumable_experiment_that_fails_keeps_its_folder_and_its_runs(tmp_path, capsys, monkeypatch):
+    """Whatever stops a resumable experiment (here an error after some runs), the folder it made stays:
+    its store may hold hours of finished runs."""
+    from twin.exceptions import InvalidScenario
+    from twin.experiments.whatifs import payload
+
+    def run(self, args, out):
+        (out / "payload-runs").mkdir()
+        (out / "payload-runs" / "results.sqlite").write_bytes(b"runs")
+        raise InvalidScenario("late")
+
+    monkeypatch.setattr(type(payload.EXPERIMENT), "run", run)
+    out = tmp_path / "p"
+    assert main(["whatif", "payload", "--out", str(out)]) == 2
+    _one_line_error(capsys, "late")
+    assert (out / "payload-runs" / "results.sqlite").read_bytes() == b"runs"

@@ -17,7 +17,8 @@ from twin.experiments.whatifs import WHATIFS
 
 def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
     """Exit 0, or 1 when some run failed, or 130 when interrupted (a resumable one keeps its runs). A folder
-    this command made is removed again when it stops without its results, unless it keeps finished runs."""
+    this command made is removed again when it stops without its results, unless the experiment is resumable
+    (its store may hold finished runs, whatever stopped it)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
     made = not args.out.exists()
     args.out.mkdir(exist_ok=True)
@@ -32,8 +33,8 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
                       "run the same command again to finish the rest", file=sys.stderr)
                 return EXIT_INTERRUPTED
             paths = experiment.publish(outcome, args.out)  # all of them or none
-    except BaseException as stop:
-        if made and not (experiment.resumable and isinstance(stop, KeyboardInterrupt)):
+    except BaseException:
+        if made and not experiment.resumable:  # a resumable one's store may hold finished runs: never
             shutil.rmtree(args.out, ignore_errors=True)
         raise
     print(outcome.answer)
