@@ -389,3 +389,16 @@ def test_cli_rejects_a_bad_axis_with_one_line(tmp_path):
     assert proc.returncode == 2
     assert "heavy" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "x").exists()
+
+
+def test_the_printed_summary_shows_no_negative_zero():
+    """An SSE that rounds to zero prints as +0.00 (the probe of 2026-11-26 saw `[ -0.00, -0.00]`)."""
+    from twin.batch.tables import format_summary
+
+    group = {"controller": "ffpva", "trajectory": 1, "payload_g": 0.0, "orientation": "horizontal",
+             "plant": "thesis", "supply_kpa": None, "pwm_period_ms": None, "runs": 2, "failed": 0,
+             "rmse_mean_deg": 0.5, "rmse_std_deg": 0.01, "sse_min_deg": -0.001, "sse_max_deg": -0.004}
+    line = format_summary([group]).splitlines()[1]
+    assert "[ +0.00, +0.00]" in line and "-0.00" not in line
+    group.update(sse_min_deg=-0.006, sse_max_deg=0.004)
+    assert "[ -0.01, +0.00]" in format_summary([group])

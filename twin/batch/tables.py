@@ -78,12 +78,17 @@ def write_summary(summary: Sequence[dict], out: pathlib.Path) -> None:
     write_csv(summary, SUMMARY_COLUMNS, out / "summary.csv")
 
 
+def _hundredths(value: float) -> str:
+    """Signed to 0.01, with a value that rounds to zero shown as +0.00, not -0.00."""
+    return f"{round(value, 2) + 0.0:+6.2f}"
+
+
 def format_summary(summary: Sequence[dict], limit: int = 40) -> str:
     lines = [f"{'controller':10} {'T':>2} {'payload g':>9} {'orient':>10} {'plant':>8} {'kPa':>5} {'PWM ms':>6} "
              f"{'runs':>4} {'fail':>4} {'RMSE mean±std':>14} {'SSE range':>16}"]
     for s in summary[:limit]:
         sse_range = ("   - (ends moving)" if math.isnan(s["sse_min_deg"])
-                     else f"[{s['sse_min_deg']:+6.2f},{s['sse_max_deg']:+6.2f}]")
+                     else f"[{_hundredths(s['sse_min_deg'])},{_hundredths(s['sse_max_deg'])}]")
         lines.append(
             f"{s['controller']:10} {s['trajectory']:>2} {s['payload_g']:>9g} {s['orientation']:>10} {s['plant']:>8} "
             f"{'-' if s['supply_kpa'] is None else format(s['supply_kpa'], 'g'):>5} "

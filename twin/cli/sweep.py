@@ -40,7 +40,7 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
     from twin.batch.sweep import open_store, run_sweep
 
     open_store(args.out).close()  # refuses a store of another code version before any output
-    print(f"{len(points)} scenarios -> {args.out.resolve()}", file=sys.stderr)
+    print(f"{len(points)} scenario{'' if len(points) == 1 else 's'} -> {args.out.resolve()}", file=sys.stderr)
     bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
     try:
         outcome = run_sweep(points, out=args.out, workers=args.workers, backend=args.backend,
