@@ -41,10 +41,11 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
 
     open_store(args.out).close()  # refuses a store of another code version before any output
     print(f"{len(points)} scenario{'' if len(points) == 1 else 's'} -> {args.out.resolve()}", file=sys.stderr)
+    # refreshed at each count, so a resumed sweep shows what was done before at once, not at its next batch
     bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
     try:
         outcome = run_sweep(points, out=args.out, workers=args.workers, backend=args.backend,
-                            address=args.ray_address, progress=bar.update)
+                            address=args.ray_address, progress=lambda n: (bar.update(n), bar.refresh()))
     except KeyboardInterrupt:
         bar.close()
         print(f"interrupted: finished scenarios are kept in {args.out / 'results.sqlite'}; "
