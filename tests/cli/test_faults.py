@@ -422,7 +422,8 @@ def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, 
     (["sweep", "--controller", "ffpva", "--trajectory", "1", "--seed", str(2**63), "--out", "OUT"],
      "seed must be an integer from 0 to 2^63 - 1"),
     (["sweep", "--controller", "ffpva", "--trajectory", "1", "--out", "OUT", "--workers", "99999"],
-     "workers must be an integer from 1 to"),
+     "--workers: at most"),
+    (["study", "robustness", "--out", "OUT", "--workers", "99999"], "workers must be an integer from 1 to"),
     (["whatif", "smc-phi", "--out", "OUT", "--seeds", "1001"], "seeds per case must be an integer from 1 to 1000"),
     (["whatif", "observer", "--out", "OUT", "--seeds", "100000"], "seeds per case"),
     (["demo", "--out", "OUT", "--seeds", "100000"], "seeds per case"),
@@ -430,6 +431,7 @@ def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, 
     (["whatif", "smc-phi", "--out", "OUT", "--phis", "0.2,,0.3"], "--phis: numbers in m/s separated by commas"),
     (["whatif", "pva-rate", "--out", "OUT", "--rates", "8,,16"], "--rates: whole milliseconds"),
     (["whatif", "pva-rate", "--out", "OUT", "--rates", "16"], "a period other than the thesis's 16 ms"),
+    (["whatif", "smc-phi", "--out", "OUT", "--phis", "0.3"], "a phi other than the plant's own 0.3 m/s"),
     (["whatif", "gear-load", "--out", ""], "the output folder must be named"),
     (["sweep", "--controller", "ffpva", "--trajectory", "1", "--out", ""], "the output folder must be named"),
     (["view", "--controller", "smc", "--trajectory", "4", "--html", "/proc/a.html"], "cannot write '/proc/a.html'"),
@@ -540,3 +542,38 @@ def test_a_resumable_experiment_that_fails_keeps_its_folder_and_its_runs(tmp_pat
     assert main(["whatif", "payload", "--out", str(out)]) == 2
     _one_line_error(capsys, "late")
     assert (out / "payload-runs" / "results.sqlite").read_bytes() == b"runs"
+
+
+def test_a_second_command_on_a_busy_new_folder_removes_nothing(tmp_path, capsys):
+    """The folder another command made and is writing into (it holds the lock) is left whole when a second
+    command on the same --out is refused: the second one did not make it, whatever it saw first."""
+    from twin.batch.lock import folder_lock
+
+    out = tmp_path / "busy"
+    out.mkdir()
+    (out / "work.bin").write_bytes(b"hours")
+    with folder_lock(out):
+        assert main(["whatif", "gear-load", "--out", str(out)]) == 2
+    _one_line_error(capsys, "is being written by process")
+    assert (out / "work.bin").read_bytes() == b"hours"
+
+
+def test_a_folder_made_here_but_locked_by_another_first_is_left_to_it(tmp_path, capsys, monkeypatch):
+    """The race: this command makes the new folder, another takes its lock first and starts writing; this
+    one is refused and must not remove the folder (it removes only while it holds the lock)."""
+    import contextlib
+
+    from twin.batch.lock import FolderBusy
+    from twin.cli import experiments
+
+    @contextlib.contextmanager
+    def taken_first(folder):
+        (folder / "theirs.bin").write_bytes(b"hours")
+        raise FolderBusy(f"{folder} is being written by process 1")
+        yield
+
+    monkeypatch.setattr(experiments, "folder_lock", taken_first)
+    out = tmp_path / "new"
+    assert main(["whatif", "gear-load", "--out", str(out)]) == 2
+    _one_line_error(capsys, "is being written by process 1")
+    assert (out / "theirs.bin").read_bytes() == b"hours"

@@ -17,13 +17,16 @@ from twin.experiments.whatifs import WHATIFS
 
 def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
     """Exit 0, or 1 when some run failed, or 130 when interrupted (a resumable one keeps its runs). A folder
-    this command made is removed again when it stops without its results, unless the experiment is resumable
-    (its store may hold finished runs, whatever stopped it)."""
+    this command made is removed again, while it still holds the folder's lock, when it stops without its
+    results, unless the experiment is resumable (its store may hold finished runs, whatever stopped it)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
-    made = not args.out.exists()
-    args.out.mkdir(exist_ok=True)
     try:
-        with folder_lock(args.out):  # one writer per folder
+        args.out.mkdir()  # made here, atomically: two commands on one new folder cannot both think so
+        made = True
+    except FileExistsError:
+        made = False
+    with folder_lock(args.out):  # one writer per folder (a second one stops here, removing nothing)
+        try:
             try:
                 outcome = experiment.run(args, args.out)
             except KeyboardInterrupt:
@@ -33,10 +36,10 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
                       "run the same command again to finish the rest", file=sys.stderr)
                 return EXIT_INTERRUPTED
             paths = experiment.publish(outcome, args.out)  # all of them or none
-    except BaseException:
-        if made and not experiment.resumable:  # a resumable one's store may hold finished runs: never
-            shutil.rmtree(args.out, ignore_errors=True)
-        raise
+        except BaseException:
+            if made and not experiment.resumable:
+                shutil.rmtree(args.out, ignore_errors=True)
+            raise
     print(outcome.answer)
     print(f"wrote {', '.join(str(p) for p in paths)}")
     return 1 if outcome.failed else 0

@@ -24,6 +24,10 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if not axes:
         raise InvalidScenario("the sweep names no axes: give at least one, e.g. --seed 0-4 (or --config GRID.toml)")
     points = grid.expand(axes)
+    if args.backend == "local" and args.workers is not None and args.workers > arguments.MAX_WORKERS:
+        # with Ray, --workers counts the cluster's CPUs, which this machine's cores do not bound
+        raise InvalidScenario(f"--workers: at most {arguments.MAX_WORKERS} local processes (four per core), got "
+                              f"{args.workers}")
     args.out.mkdir(exist_ok=True)
     previous = signal.signal(signal.SIGTERM, signal.default_int_handler)  # SIGTERM stops it as Ctrl-C does
     try:
@@ -75,7 +79,7 @@ def add_parser(sub) -> None:
                            help="comma list; numbers also start:stop:step; seeds also a-b")
     sweep.add_argument("--config", type=pathlib.Path, metavar="GRID.toml", help="axes from a TOML file")
     sweep.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="results folder (created)")
-    sweep.add_argument("--workers", type=arguments.workers, default=None,
+    sweep.add_argument("--workers", type=arguments.positive_int, default=None,
                        help="processes (default: all cores); with Ray, CPUs to size chunks for (default: the cluster's)")
     sweep.add_argument("--backend", choices=("local", "ray"), default="local")
     sweep.add_argument("--ray-address", default=None, help="Ray cluster address (default: RAY_ADDRESS or local)")

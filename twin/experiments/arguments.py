@@ -13,7 +13,8 @@ import tempfile
 from twin.sim.scenario import MAX_SEED
 
 MAX_SEEDS = 1000  # noise seeds per case a command takes (a what-if's cells times 1000 is already a day's work)
-MAX_WORKERS = 4 * (os.cpu_count() or 1)  # local processes a command may start: more only queue for the cores
+MAX_WORKERS = 4 * len(os.sched_getaffinity(0))  # local processes a command may start: more only queue for the
+# cores this process may use
 
 
 def writable_file(suffix: str):

@@ -31,6 +31,7 @@ THESIS_EXPERIMENT_MAX_ERROR_DEG = {"pva": {1: 13.5}, "ffpva": {1: 5.0, 2: 5.0, 3
 # digit or two). That the slowest came at the lowest pressure and the
 # fastest at the highest is *inferred*. (supply Pa gauge, rack speed m/s, which end of the range).
 THESIS_FULL_DUTY_SPEEDS = ((BREAKAWAY_TEST_PRESSURE, 0.03, "slowest"), (575e3, 0.12, "fastest"))
+THESIS_FULL_DUTY_SPEED_DIGIT = 0.01  # m/s, the last place both speeds are printed to: each stands for +- half of it
 
 # The robustness study's tip payloads (§9), g: none, then the thesis's two.
 THESIS_PAYLOADS_G = (0.0, *(round(m * 1e3, 9) for m in THESIS_PAYLOADS))
