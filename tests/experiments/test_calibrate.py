@@ -252,11 +252,15 @@ def test_same_seeds_same_fit_whatever_the_workers():
 @pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluation (the centre of the box) costs
-    exactly what the committed file says. The whole fit (about 8 min on 2 cores) is
-    ``twin calibrate --out DIR``; its file equals the committed one (see docs/as-built.md)."""
+    what the committed file says. The whole fit (about 8 min on 2 cores) is ``twin calibrate --out DIR``;
+    its file equals the committed one (see docs/as-built.md). Exact on the machine that wrote the file; on
+    2026-11-26's machine (the same numpy 2.4.6, numba 0.68.1 and mujoco 3.17.0 the file records, another
+    CPU) the same code of 0fcd75a, which passed this exactly the day before, costs 0.9140406738291886 against
+    0.914040673829233: the last bits of floating point differ between machines. So the cost is held to 1e-12
+    of itself (a change to the model or the cost moves it by far more); the values stay exact."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, scan_points=0, simplex_evaluations=0, profile_points=0,
                                  noise_seed_sets=(), check_seeds=())
     (first,) = result.history
     assert first.values == committed["history"][0]["values"]
-    assert first.cost == committed["history"][0]["cost"]
+    assert first.cost == pytest.approx(committed["history"][0]["cost"], rel=1e-12, abs=0.0)
