@@ -666,6 +666,7 @@ def test_report_sets_the_full_duty_speeds_beside_the_measured_range_both_ways():
     def row(pressure, measured, end, built, unscaled, ratio):
         return {"pressure": pressure, "measured": measured, "end": end,
                 "interval": (measured - 0.005, measured + 0.005), "ratio": ratio,
+                "way": int(np.argmin(built["speeds"]) if end == "slowest" else np.argmax(built["speeds"])),
                 "runs": {"thesis": _full_duty_run(0.035, 0.035) if end == "slowest" else _full_duty_run(0.123, 0.123),
                          "as-built": built, "as-built, no CCW scale": unscaled}}
 
@@ -686,9 +687,9 @@ def test_report_sets_the_full_duty_speeds_beside_the_measured_range_both_ways():
     # a way that never moved, a way that stopped short of the window's end, a run that failed: said as such,
     # never as a speed of 0 or a physical finding
     rows[0]["runs"]["as-built"] = _full_duty_run(0.026, math.nan, travel=(15e-3, 0.2e-3))
-    rows[0]["ratio"] = math.nan
+    rows[0]["ratio"], rows[0]["way"] = math.nan, None
     rows[1]["runs"]["as-built"] = _full_duty_run(0.100, math.nan, travel=(15e-3, 4e-3))
-    rows[1]["ratio"] = math.nan
+    rows[1]["ratio"], rows[1]["way"] = math.nan, None
     text = validate.report(v)
     assert "| 245 | 30 (slowest; 25-35) | 35 / 35 | 26 / did not break away | – |" in text
     assert "CW / CCW: 100 / did not cross the window (went 4.0 mm)" in text

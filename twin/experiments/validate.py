@@ -312,23 +312,16 @@ def full_duty_runs(cases: Sequence[tuple]) -> list[dict]:
     return runs
 
 
-def full_duty_speeds(plant, pressure: float) -> tuple[float, float]:
-    """The (CW, CCW) speeds of :func:`full_duty_runs` for one plant at one supply pressure (Pa gauge)."""
-    return full_duty_runs([(plant, pressure)])[0]["speeds"]
-
-
 def full_duty_rows() -> list[dict]:
     """§4.5.1's measured rack speeds against the twin's (a check: the thesis gives only the range's two ends,
     each to :data:`THESIS_FULL_DUTY_SPEED_DIGIT`, and which pressure each came at is inferred). Per end of the
     range: the supply, the measured speed and the interval its printed digit allows, and :func:`full_duty_runs`
-    for each of :data:`FULL_DUTY_PLANTS` and for as-built with its CCW Coulomb scale at 1 (``runs``), and
-    as-built's slowest (or fastest) way over the measured (nan when that way failed or did not cross the
-    window). Added 2026-11-26, after every other result of this report."""
+    for each of :data:`FULL_DUTY_PLANTS` and for as-built without its CCW friction (``runs``), and, when
+    as-built's run has both speeds, its slowest (or fastest) way (``way``, 0 CW or 1 CCW, else None) and that
+    way's speed over the measured (``ratio``, else nan). Added 2026-11-26, after every other result of this report."""
     from twin.plants.as_built import as_built_plant
 
-    built = as_built_plant()
-    unscaled = dataclasses.replace(built, params=dataclasses.replace(built.params, friction=dataclasses.replace(
-        built.params.friction, ccw_coulomb_scale=1.0)))
+    unscaled = as_built_plant(without=("ccw_friction",))  # its CCW Coulomb scale at 1
     names = (*FULL_DUTY_PLANTS, "as-built, no CCW scale")
     cases = [(plant, pressure) for pressure, _, _ in THESIS_FULL_DUTY_SPEEDS for plant in (*FULL_DUTY_PLANTS, unscaled)]
     runs = iter(full_duty_runs(cases))
@@ -338,10 +331,11 @@ def full_duty_rows() -> list[dict]:
                "interval": (measured - THESIS_FULL_DUTY_SPEED_DIGIT / 2,
                             measured + THESIS_FULL_DUTY_SPEED_DIGIT / 2),
                "runs": {name: next(runs) for name in names}}
-        built_run = row["runs"]["as-built"]
-        speeds = built_run["speeds"]
-        usable = not built_run["warnings"] and all(math.isfinite(x) for x in speeds)
-        row["ratio"] = (min if end == "slowest" else max)(speeds) / measured if usable else math.nan
+        built = row["runs"]["as-built"]
+        speeds = built["speeds"]
+        usable = not built["warnings"] and all(math.isfinite(x) for x in speeds)
+        row["way"] = (int(np.argmin(speeds)) if end == "slowest" else int(np.argmax(speeds))) if usable else None
+        row["ratio"] = speeds[row["way"]] / measured if usable else math.nan
         rows.append(row)
     return rows
 
@@ -1045,11 +1039,11 @@ def _why_full_duty(rows: Sequence[dict] | None) -> list[str]:
         run = r["runs"]["as-built"]
         low, high = (x * 1e3 for x in r["interval"])
         measured = f"the {low:g}-{high:g} mm/s that the printed {r['end']} speed, {r['measured']:g} m/s, stands for"
-        if not math.isfinite(r["ratio"]):
+        k = r["way"]
+        if k is None:
             parts.append(f"at {r['pressure'] / 1e3:g} kPa the as-built rack CW / CCW: {_way_text(run, 0)} / "
                          f"{_way_text(run, 1)}, against {measured}")
             continue
-        k = (int(np.argmin(run["speeds"])) if r["end"] == "slowest" else int(np.argmax(run["speeds"])))
         twin = run["speeds"][k] * 1e3
         where = "inside" if low <= twin <= high else ("under" if twin < low else "over")
         parts.append(f"at {r['pressure'] / 1e3:g} kPa the as-built rack's {r['end']} way ({('CW', 'CCW')[k]}) runs "
@@ -1058,7 +1052,8 @@ def _why_full_duty(rows: Sequence[dict] | None) -> list[str]:
                      + " / ".join(_way_text(r["runs"]["thesis"], w) for w in (0, 1)))
     built = [r["runs"]["as-built"] for r in rows]
     moved = all(not run["warnings"] and min(run["travel"]) >= BROKE_AWAY for run in built)
-    ccw_slower = all(math.isfinite(r["ratio"]) and run["speeds"][1] < run["speeds"][0] for r, run in zip(rows, built, strict=True))
+    ccw_slower = all(r["way"] is not None and run["speeds"][1] < run["speeds"][0]
+                     for r, run in zip(rows, built, strict=True))
     return ["- **Full-duty speed** (§4.5.1's force-loss runs; a check: which pressure each end of the measured "
             "range came at is inferred, and the speed's window is the twin's choice): " + "; ".join(parts) + "."
             + (" The as-built joint breaks away from rest both ways at each pressure, as the rig did." if moved else
