@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import math
 
+import numpy as np
 import pytest
 
 from twin.exceptions import InvalidScenario
@@ -98,7 +99,7 @@ def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_each_prof
         return {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14,
                 "load_friction": load, "observer_gain": 100.0}
 
-    assert calibrate.PROFILED == ("load_friction", "stiction", "observer_gain")
+    assert calibrate.PROFILED == ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale")
     history = [E(v(2.0), 1.00, "scan"), E(v(1.2), 1.04, "profile"), E(v(2.4), 1.05, "profile"),
                E(v(1.8), 1.02, "simplex"), E(v(1.8), 1.02, "simplex"), E(v(2.5), 1.30, "profile"),
                E(v(1.9, 0.02), 1.01, "simplex")]
@@ -174,6 +175,28 @@ def test_the_breakaway_bound_is_what_245_kpa_could_start_from_rest():
     assert breakaway.high == pytest.approx(2.5788, abs=1e-4)
 
 
+def test_the_ccw_scale_bound_is_what_the_slowest_full_duty_speed_allows():
+    """§4.5.1: the rack ran at no less than 0.03 m/s (printed to 0.01, so 25 mm/s) with the pair at 100 % from
+    245 kPa, both ways. Eq. 4.3.6's steady state, written out here from the thesis's equations (4.4.2, 4.5.5,
+    4.5.7, 4 mm bore), not through the twin's code, runs the rack at 25 mm/s over 5-11 mm with the Coulomb level
+    scaled by the box's top, faster below it and slower above."""
+    from twin.plants.as_built import CCW_SCALE_BOUND, FULL_DUTY_WINDOW
+
+    area = math.pi * 2e-3**2
+    damping = 45.9 + 2 * 1.8372e14 * 100.0**-2.1706 * area**2  # F_v + R1 + R4 at 100 %, N s/m
+    y = np.linspace(5e-3, 11e-3, 60001)
+    coulomb = np.maximum(np.polyval((-3.051e14, 1.587e13, -3.244e11, 3.294e9, -1.727e7, 4.36e4, -39.551), y), 0.0)
+
+    def speed(scale):
+        return 6e-3 / np.trapezoid(damping / (245e3 * area - scale * coulomb), y)
+
+    (ccw,) = [f for f in FITTED if f.name == "ccw_coulomb_scale"]
+    assert ccw.high == CCW_SCALE_BOUND and FULL_DUTY_WINDOW == (5e-3, 11e-3)
+    assert speed(ccw.high) == pytest.approx(0.025, rel=1e-4)
+    assert speed(1.0) == pytest.approx(0.035, abs=5e-4) and speed(1.5) < 0.015  # the old top: 13 mm/s
+    assert ccw.high == pytest.approx(1.269, abs=1e-3)
+
+
 def test_committed_preset_is_inside_its_bounds_and_is_the_as_built_plant():
     from twin.plants.preset import THESIS_PARAMS
 
@@ -241,8 +264,8 @@ def test_same_seeds_same_fit_whatever_the_workers():
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    # two points along each profiled parameter (the load friction, the breakaway, the observer gain)
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 6
+    # two points along each profiled parameter (the load friction, the breakaway, the observer gain, the CCW scale)
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 8
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)
@@ -252,12 +275,12 @@ def test_same_seeds_same_fit_whatever_the_workers():
 @pytest.mark.slow  # over ~2.5 s on 2 cores
 def test_calibrate_retraces_the_committed_fit():
     """The same seeds give the same numbers: the fit's first evaluation (the centre of the box) costs
-    what the committed file says. The whole fit (about 8 min on 2 cores) is ``twin calibrate --out DIR``;
-    its file equals the committed one (see docs/as-built.md). Exact on the machine that wrote the file; on
-    2026-11-26's machine (the same numpy 2.4.6, numba 0.68.1 and mujoco 3.17.0 the file records, another
-    CPU) the same code of 0fcd75a, which passed this exactly the day before, costs 0.9140406738291886 against
-    0.914040673829233: the last bits of floating point differ between machines. So the cost is held to 1e-12
-    of itself (a change to the model or the cost moves it by far more); the values stay exact."""
+    what the committed file says. The whole fit (8 min on 2 cores on 2026-11-25's machine, 14.5 min on
+    2026-11-26's) is ``twin calibrate --out DIR``; its file is the committed one (see docs/as-built.md). On
+    2026-11-26's machine (the same numpy 2.4.6, numba 0.68.1 and mujoco 3.17.0, another CPU) the eighth
+    refit's file, written on the other machine, cost 0.9140406738291886 against its 0.914040673829233: the
+    last bits of floating point differ between machines. So the cost is held to 1e-12 of itself (a change to
+    the model or the cost moves it by far more); the values stay exact."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, scan_points=0, simplex_evaluations=0, profile_points=0,
                                  noise_seed_sets=(), check_seeds=())

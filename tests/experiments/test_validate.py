@@ -123,10 +123,10 @@ def test_report_says_plainly_what_misses_and_what_the_runs_show():
     assert "T2: measured sliding mode < FF + PVA < PVA + DZC, twin FF + PVA < PVA + DZC < sliding mode" in text
     assert "T1: measured" not in text  # right there
     assert "does **not** lag the model" in text and "tracks it better than the real joint did" in text
-    assert "spans 1.00-2.20 N of breakaway and 0.15-0.45 N/N of load friction" in text
+    assert "members span load friction 0.15-0.45 N/N, breakaway 1.00-2.20 N, observer gain 340 1/s (one value)" in text
     assert "no run of any member stalls" in text
     assert "does not turn on them" in text  # a 0.3 deg band
-    assert "their load friction (N/N): 0.15, 0.45; their observer gain (1/s): 340, 340." in text
+    assert "The members, in order: load friction (N/N): 0.15, 0.45; breakaway (N): 1.00, 2.20; observer gain (1/s): 340, 340." in text
     other = validate.report(_fake(1.0, lag_within=True, stalled=3))
     assert "lags the model, as the real joint did" in other and "Within tolerance." in other
     assert "some members' runs stall" in other
@@ -141,9 +141,29 @@ def test_report_judges_the_dependence_on_every_member_not_the_band_alone():
     per_member = [[2.8], [2.85], [2.9], [2.9], [2.95], [3.0], [3.1], [4.5]]
     text = validate.report(_fake(1.0, lag_within=True, stalled=0, members=members, per_member=per_member))
     assert "members' means span 2.80-4.50 deg" in text
-    assert "to the one with 1.50 N and 0.45 N/N" in text
+    # only what sets the two apart is named; the spans name every profiled parameter the members carry
+    assert "from the member with load friction 0.30 N/N to the one with load friction 0.45 N/N" in text
+    assert ("the ensemble's 8 members span load friction 0.30-0.45 N/N, breakaway 1.50 N (one value), observer "
+            "gain 340 1/s (one value), fitting") in text
+    assert "The members, in order: load friction (N/N): 0.30, 0.30, 0.30, 0.30, 0.30, 0.30, 0.30, 0.45; breakaway" in text
     assert "**turns on them** there" in text and "does not turn on them" not in text
     assert "| 2.90 | 2.80 | 2.90 | 3.10 | 2.80-4.50 | 0 |" in text
+
+
+def test_report_names_every_parameter_the_members_differ_in_and_only_those_that_set_two_apart():
+    """The spans list each profiled parameter (one value said as such) and any other the members differ in
+    (here the leak, which a simplex step moved), not one they share (the air); the widest cell's two members
+    are told apart by what differs between them alone."""
+    base = {"stiction": 1.09, "air_fraction": 0.0283, "ccw_coulomb_scale": 1.16, "leak_conductance": 1.39e-14,
+            "load_friction": 0.29, "observer_gain": 340.0}
+    members = [base, dict(base, ccw_coulomb_scale=1.27), dict(base, leak_conductance=1.16e-14, load_friction=0.38)]
+    text = validate.report(_fake(1.0, lag_within=True, stalled=0, members=members, per_member=[[3.4], [3.5], [4.1]]))
+    assert ("the ensemble's 3 members span load friction 0.29-0.38 N/N, breakaway 1.09 N (one value), observer gain "
+            "340 1/s (one value), CCW Coulomb scale 1.16-1.27, leak 1.16-1.39 x 1e-14 m^3/(Pa s), fitting") in text
+    assert ("from the member with load friction 0.29 N/N and leak 1.39 x 1e-14 m^3/(Pa s) to the one with load "
+            "friction 0.38 N/N and leak 1.16 x 1e-14 m^3/(Pa s)") in text
+    assert "CCW Coulomb scale: 1.16, 1.27, 1.16; leak (x 1e-14 m^3/(Pa s)): 1.39, 1.39, 1.16." in text
+    assert "air" not in text.split("The members, in order:")[1].split("|")[0]
 
 
 def test_report_shows_what_sliding_modes_switching_term_does():
@@ -645,6 +665,9 @@ def test_the_thesis_plants_full_duty_speed_is_eq_4_3_6s_steady_state():
     through the twin's code; CCW with the same Coulomb level (the thesis plant has no CCW scale)."""
     from scipy import integrate
 
+    from twin.physics.hydraulics import full_duty_speed
+    from twin.plants.preset import THESIS_PARAMS
+
     area = math.pi * 2e-3**2
     resistance = 1.8372e14 * 100.0**-2.1706  # eq. 4.4.2 at 100 % duty, Pa s/m^3
     viscous = 45.9  # N s/m, eq. 4.5.5
@@ -656,6 +679,8 @@ def test_the_thesis_plants_full_duty_speed_is_eq_4_3_6s_steady_state():
         expected = (high - low) / integrate.trapezoid((viscous + 2 * resistance * area**2) / (pressure * area - coulomb), y)
         assert run["warnings"] == 0 and run["speeds"] == pytest.approx((expected, expected), rel=2e-3)
         assert min(run["travel"]) > high - low
+        # the same closed form in the physics layer, which the CCW friction's bound is worked out with
+        assert full_duty_speed(THESIS_PARAMS, pressure, validate.FULL_DUTY_WINDOW) == pytest.approx(expected, rel=1e-6)
 
 
 def _full_duty_run(cw: float, ccw: float, travel=(15e-3, 15e-3), warnings: int = 0) -> dict:

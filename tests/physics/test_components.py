@@ -194,6 +194,13 @@ def test_coulomb_force_broadcasts_and_scales_only_towards_zero_degrees():
     assert float(coulomb_force(params, 8e-3, -1.0)) == pytest.approx(grid[1, 1], rel=1e-12)
 
 
+def test_coulomb_level_is_coulomb_force_towards_plus_y_in_plain_numpy():
+    from twin.physics.friction import coulomb_level
+
+    y = np.linspace(-10e-3, 30e-3, 4001)  # across the clamps and the dip below zero near 12 mm
+    assert coulomb_level(FrictionParams(), y) == pytest.approx(_fc(y), rel=1e-12, abs=1e-12)
+
+
 def test_coulomb_force_is_never_negative():
     y = np.linspace(-10e-3, 30e-3, 4001)
     assert np.all(_fc(y) >= 0.0)

@@ -46,6 +46,7 @@ from twin.experiments.reference import (
     THESIS_FULL_DUTY_SPEEDS,
     THESIS_SIMULATED_RMSE_DEG,
 )
+from twin.plants.as_built import CCW_SCALE_BOUND, FULL_DUTY_WINDOW
 from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import plt
@@ -56,6 +57,44 @@ RMSE_TOLERANCE = 0.20
 SSE_TOLERANCE_DEG = 0.5
 DELAY_TOLERANCE = 1e-3  # s
 STALL_ERROR_DEG = 30.0  # a run whose error passes this did not follow the trajectory (stalled)
+# How the report names a fitted parameter, writes its value and its unit (the ensemble's members differ in them).
+PARAMETER_TEXT = {
+    "stiction": ("breakaway", lambda x: f"{x:.2f}", "N"),
+    "air_fraction": ("air", lambda x: f"{x * 100:.2f}", "%"),
+    "ccw_coulomb_scale": ("CCW Coulomb scale", lambda x: f"{x:.2f}", ""),
+    "leak_conductance": ("leak", lambda x: f"{x * 1e14:.2f}", "x 1e-14 m^3/(Pa s)"),
+    "load_friction": ("load friction", lambda x: f"{x:.2f}", "N/N"),
+    "observer_gain": ("observer gain", lambda x: f"{x:.0f}", "1/s"),
+}
+
+
+def _with_unit(text: str, unit: str) -> str:
+    return f"{text} {unit}" if unit else text
+
+
+def _member_text(member: dict, names: Sequence[str]) -> str:
+    """``member``'s values of ``names``, as the report writes them ("breakaway 1.21 N and load friction ...")."""
+    return " and ".join(f"{PARAMETER_TEXT[n][0]} {_with_unit(PARAMETER_TEXT[n][1](member[n]), PARAMETER_TEXT[n][2])}"
+                        for n in names)
+
+
+def _profiled(members: Sequence[dict]) -> list[str]:
+    """The parameters to show across ``members``: the profiled ones every member carries, in the fit's order,
+    then any other they differ in (a simplex step may have moved it)."""
+    carried = [n for n in PARAMETER_TEXT if all(n in m for m in members)]
+    return ([n for n in calibrate.PROFILED if n in carried]
+            + [n for n in carried if n not in calibrate.PROFILED and len({m[n] for m in members}) > 1])
+
+
+def _spans_text(members: Sequence[dict]) -> str:
+    """The span of each profiled parameter over the ensemble's ``members`` (one value said as such)."""
+    parts = []
+    for name in _profiled(members):
+        label, fmt, unit = PARAMETER_TEXT[name]
+        low, high = fmt(min(m[name] for m in members)), fmt(max(m[name] for m in members))
+        parts.append(f"{label} {_with_unit(f'{low}-{high}', unit)}" if low != high else
+                     f"{label} {_with_unit(low, unit)} (one value)")
+    return ", ".join(parts)
 PREDICTION_CELLS = tuple(cell for cell in ROBUSTNESS_CELLS if cell[1] == 3)  # the held-back T3 cells
 VALIDATION_COLUMNS = ("source", "controller", "trajectory", "payload_g", "orientation", "plant", "measured",
                       "twin_mean", "twin_std", "ratio", "within_tolerance")
@@ -260,9 +299,6 @@ def valve_rows() -> list[dict]:
                          twin * 1e3, None, abs(twin - measured) <= DELAY_TOLERANCE))
     return rows
 
-FULL_DUTY_WINDOW = (5e-3, 11e-3)  # m of rack travel a full-duty run's speed is taken over (the twin's choice; how
-# the rig took its speeds the thesis does not say): inside eq. 4.5.7's 2-14.5 mm, and at least 2 mm from where
-# each way starts (T1's start, 2.5 mm; the far stop, 20 mm)
 FULL_DUTY_TURN = 0.6  # s at 100 % one way (past the window's far end at 245 kPa), then 100 % the other
 FULL_DUTY_PLANTS = ("thesis", "as-built")
 BROKE_AWAY = 1e-3  # m: a way the rack travelled at least this far from where that way started broke away
@@ -1120,9 +1156,7 @@ def _why(v: Validation) -> list[str]:
                      "The twin's chambers build pressure faster than the real ones did.")
     lines += _why_full_duty(v.full_duty)
     members = v.prediction_detail["members"]
-    low, high = min(m["stiction"] for m in members), max(m["stiction"] for m in members)
-    load_low, load_high = min(m["load_friction"] for m in members), max(m["load_friction"] for m in members)
-    # Judged on every member's mean, not on the 10-90 % band alone: with eight members the band's ends are
+    # Judged on every member's mean, not on the 10-90 % band alone: with a few members the band's ends are
     # interpolated between the two lowest and the two highest, so one member set apart by a parameter that
     # the data do not pin would fall mostly outside it.
     means = member_means(v.prediction_detail)
@@ -1130,15 +1164,14 @@ def _why(v: Validation) -> list[str]:
     k = int(np.argmax(span / np.array([r["band_p50"] for r in v.prediction])))
     widest, relative = v.prediction[k], span[k] / v.prediction[k]["band_p50"]
     lowest, highest = members[int(np.argmin(means[k]))], members[int(np.argmax(means[k]))]
-    lines.append(f"- **The breakaway and the load friction**: the ensemble spans {low:.2f}-{high:.2f} N of "
-                 f"breakaway and {load_low:.2f}-{load_high:.2f} N/N of load friction, fitting the "
-                 f"measurements about equally well. The T3 cell that depends on them most is "
-                 f"{CONTROLLER_LABELS[widest['controller']]} {widest['payload_g']:g} g {widest['orientation']}: its "
-                 f"members' means span {means[k].min():.2f}-{means[k].max():.2f} deg ({relative:.0%} "
-                 f"of the median; 10-90 % band {widest['band_p10']:.2f}-{widest['band_p90']:.2f}), from the member with "
-                 f"{lowest['stiction']:.2f} N and {lowest['load_friction']:.2f} N/N to the one with "
-                 f"{highest['stiction']:.2f} N and {highest['load_friction']:.2f} N/N. So within what the data allow "
-                 "the T3 prediction "
+    differ = [n for n in _profiled(members) if lowest[n] != highest[n]]
+    lines.append(f"- **The parameters the data do not pin**: the ensemble's {len(members)} members span "
+                 f"{_spans_text(members)}, fitting the measurements about equally well. The T3 cell that depends "
+                 f"on them most is {CONTROLLER_LABELS[widest['controller']]} {widest['payload_g']:g} g "
+                 f"{widest['orientation']}: its members' means span {means[k].min():.2f}-{means[k].max():.2f} deg "
+                 f"({relative:.0%} of the median; 10-90 % band {widest['band_p10']:.2f}-{widest['band_p90']:.2f}), "
+                 f"from the member with {_member_text(lowest, differ)} to the one with "
+                 f"{_member_text(highest, differ)}. So within what the data allow the T3 prediction "
                  + ("does not turn on them" if relative < RMSE_TOLERANCE else "**turns on them** there: read the "
                     "members' range, not the committed value")
                  + (" (no run of any member stalls)." if not any(r["stalled_runs"] for r in v.prediction) else
@@ -1324,6 +1357,7 @@ def report(v: Validation) -> str:
     if v.full_duty:
         low, high = (f"{x * 1e3:g}" for x in FULL_DUTY_WINDOW)
         (p_low, s_low, _), (p_high, s_high, _) = THESIS_FULL_DUTY_SPEEDS
+        low_end = (s_low - THESIS_FULL_DUTY_SPEED_DIGIT / 2) * 1e3
         lines += ["## Full-duty rack speed (§4.5.1; a check)", "",
                   "The force-loss runs started the joint from rest with both valves of the pair at 100 % duty, both "
                   f"ways, at supply pressures from {p_low / 1e3:g} to {p_high / 1e3:g} kPa; the rack ran at "
@@ -1334,7 +1368,12 @@ def report(v: Validation) -> str:
                   f"from T1's start, 100 % out for {FULL_DUTY_TURN:g} s, then 100 % back; the speed is the mean over "
                   f"the rack's travel from {low} to {high} mm each way (the twin's choice; CCW is towards 0 deg). "
                   "`as-built / measured` takes its slowest way at the low end, its fastest at the high end. Added "
-                  "2026-11-26, after every other result of this report.", "",
+                  "2026-11-26, after every other result of this report. Since the ninth refit (the same day) the slow "
+                  "end also bounds the fit: the CCW Coulomb scale's top, "
+                  f"{CCW_SCALE_BOUND:.3f}, is where the thesis's own model (eq. 4.3.6's steady state over the same "
+                  f"window) runs CCW at {low_end:g} mm/s at {p_low / 1e3:g} kPa. The as-built joint, with its own "
+                  "losses besides, is set against the measured range below.",
+                  "",
                   "| supply (kPa) | measured (mm/s) | thesis model, CW / CCW | as-built, CW / CCW | "
                   "as-built / measured |", "|---|---|---|---|---|"]
         for r in v.full_duty:
@@ -1348,11 +1387,12 @@ def report(v: Validation) -> str:
     lines += ["## Prediction: Chapter 6 T3 (blind)", "",
               f"The held-back T3 cells, predicted on the committed preset (five runs) and on each of the "
               f"{len(d['members'])} members of the calibration ensemble (five runs each). The band is the 10-90 % "
-              "range of the members' five-run means (with eight members its ends are interpolated, so the lowest and the highest member are listed beside it); `stalled` counts the members' runs whose error passed "
-              f"{STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). Breakaway of the members (N): "
-              + ", ".join(f"{m['stiction']:.2f}" for m in d["members"]) + "; their load friction (N/N): "
-              + ", ".join(f"{m['load_friction']:.2f}" for m in d["members"]) + "; their observer gain (1/s): "
-              + ", ".join(f"{m['observer_gain']:.0f}" for m in d["members"]) + ".", "",
+              f"range of the members' five-run means (with {len(d['members'])} members its ends are interpolated, so "
+              "the lowest and the highest member are listed beside it); `stalled` counts the members' runs whose "
+              f"error passed {STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). The members, in order: "
+              + "; ".join(f"{PARAMETER_TEXT[n][0]}" + (f" ({PARAMETER_TEXT[n][2]})" if PARAMETER_TEXT[n][2] else "")
+                          + ": " + ", ".join(PARAMETER_TEXT[n][1](m[n]) for m in d["members"])
+                          for n in _profiled(d["members"])) + ".", "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | members (lowest-highest) | stalled |",
               "|---|---|---|---|---|---|---|---|---|"]
     for r, means in zip(v.prediction, member_means(d), strict=True):

@@ -52,6 +52,12 @@ def coulomb_force(params: FrictionParams, y: np.ndarray, direction: np.ndarray) 
     return out
 
 
+def coulomb_level(params: FrictionParams, y: np.ndarray) -> np.ndarray:
+    """F_c(y) >= 0 in N moving towards +y, in plain numpy (no compile): eq. 4.5.7 clamped as
+    :func:`coulomb_force` does, for closed forms worked out when a module loads."""
+    return np.maximum(np.polyval(params.coulomb_poly, np.clip(np.asarray(y, dtype=float), *params.fit_range)), 0.0)
+
+
 def coulomb_both_ways(params: FrictionParams, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """F_c(y) moving towards +y and towards 0 deg, for the steps that decide the direction inside their
     compiled loops; each the same numbers as :func:`coulomb_force` in that direction."""

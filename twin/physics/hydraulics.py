@@ -44,12 +44,13 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import math
 
 import numba
 import numpy as np
 
 from twin.physics import friction
-from twin.physics.params import FrictionParams
+from twin.physics.params import FrictionParams, JointParams
 from twin.physics.scenario_axis import per_scenario
 
 
@@ -193,3 +194,23 @@ def rack_step(*, circuit_now: Circuit, friction_params: FrictionParams, bore_are
                 each(stuck, np.bool_), each(mass), float(h), static, out, stuck_out)
     return RackForces(cylinder_a=out[0], cylinder_b=out[1], pressure_a=out[2], pressure_b=out[3],
                       velocity=out[4], force_loss=out[5], stuck=stuck_out)
+
+
+def full_duty_speed(params: JointParams, supply_pressure: float, window: tuple[float, float],
+                    coulomb_scale: float = 1.0) -> float:
+    """The rack's mean speed (m/s) over ``window`` (m of rack travel) with both valves of the pair at 100 %,
+    in eq. 4.3.6's quasi-steady state (the rack's mass too small to matter):
+    ``v(y) = (P_ws A - s F_c(y)) / (F_v + 2 R(100) A^2)``, the mean being the travel over the integral of
+    dy / v(y); ``s`` scales eq. 4.5.7's Coulomb level (``coulomb_scale``, as the CCW variant does). 0 if the
+    drive cannot overcome the friction somewhere in the window. The thesis's model only: it takes F_c
+    towards +y (not ``params.friction.ccw_coulomb_scale``) and no stiction, load friction, compressibility or
+    supply line. The trapezoid's sum is exactly rounded (math.fsum) and every other step elementwise, so the
+    result does not depend on the machine's summation order (a bound worked out from it is a box's edge)."""
+    low, high = window
+    y = np.linspace(low, high, 2001)
+    area = params.cylinder.bore_area
+    drive = supply_pressure * area - coulomb_scale * friction.coulomb_level(params.friction, y)
+    if np.min(drive) <= 0.0:
+        return 0.0
+    slowness = (params.friction.viscous + 2.0 * params.valves.open_resistance * area**2) / drive  # dt/dy
+    return float((high - low) / math.fsum(((slowness[1:] + slowness[:-1]) * np.diff(y) / 2.0).tolist()))
