@@ -332,15 +332,25 @@ def test_a_failing_simulation_stops_once_and_tells_the_page():
     assert json.loads(sent[0]) == {"type": "error", "message": "simulation stopped: boom"}
 
 
-def test_rebuilds_are_rate_limited_and_state_says_what_plays():
+def test_rebuilds_are_rate_limited_and_state_says_what_plays(monkeypatch):
+    # The server's clock, frozen and stepped by hand: a rebuild itself can take over 0.5 s on a loaded machine
+    # (CI on 2026-11-26 saw the second change pass the limit that way), so the wall clock cannot be the test's.
+    import viz.live_server
+
+    clock = [1000.0]
+    monkeypatch.setattr(viz.live_server.time, "monotonic", lambda: clock[0])
     session = LiveSession(Scenario("ffpva", 4, seed=0))
     assert session.state()["playing"] == "T4"
     session.handle('{"type": "target", "angle_deg": 100}')
     assert session.state()["playing"] == "target 100 deg"
     assert session.handle('{"type": "payload", "grams": 5}') is True
+    clock[0] += 0.4
     with pytest.raises(live_messages.BadMessage, match="wait 0.5 s"):
         session.handle('{"type": "orientation", "value": "vertical"}')
     assert session.scenario.orientation is Orientation.HORIZONTAL
+    clock[0] += 0.2  # 0.6 s after the last rebuild
+    assert session.handle('{"type": "orientation", "value": "vertical"}') is True
+    assert session.scenario.orientation is Orientation.VERTICAL
 
 
 def test_a_page_that_has_not_taken_its_last_frame_gets_no_new_one():
