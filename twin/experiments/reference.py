@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 from twin.physics.model import THESIS_PAYLOADS
-from twin.plants.as_built import BREAKAWAY_TEST_PRESSURE, FULL_DUTY_SPEED_DIGIT, SLOWEST_FULL_DUTY_SPEED
+from twin.plants.as_built import BREAKAWAY_TEST_PRESSURE, SLOWEST_FULL_DUTY_SPEED
 
 # Simulated RMSE per trajectory T1..T4 and SSE of T1 (§8, "Simulation").
 THESIS_SIMULATED_RMSE_DEG = {
@@ -30,9 +30,9 @@ THESIS_EXPERIMENT_MAX_ERROR_DEG = {"pva": {1: 13.5}, "ffpva": {1: 5.0, 2: 5.0, 3
 # ways, at supply pressures from 245 to 575 kPa, and its rack ran at 0.03 to 0.12 m/s (the range, given to a
 # digit or two). That the slowest came at the lowest pressure and the
 # fastest at the highest is *inferred*. (supply Pa gauge, rack speed m/s, which end of the range).
-# The slow end also bounds the as-built CCW friction (twin.plants.as_built.CCW_SCALE_BOUND), so it lives there.
+# The slow end, and the digit both ends are printed to (FULL_DUTY_SPEED_DIGIT), also bound the as-built CCW
+# friction (twin.plants.as_built.CCW_SCALE_BOUND), so they live there.
 THESIS_FULL_DUTY_SPEEDS = ((BREAKAWAY_TEST_PRESSURE, SLOWEST_FULL_DUTY_SPEED, "slowest"), (575e3, 0.12, "fastest"))
-THESIS_FULL_DUTY_SPEED_DIGIT = FULL_DUTY_SPEED_DIGIT
 
 # The robustness study's tip payloads (§9), g: none, then the thesis's two.
 THESIS_PAYLOADS_G = (0.0, *(round(m * 1e3, 9) for m in THESIS_PAYLOADS))

@@ -42,11 +42,10 @@ from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import (
     ROBUSTNESS_CELLS,
     THESIS_EXPERIMENT_MAX_ERROR_DEG,
-    THESIS_FULL_DUTY_SPEED_DIGIT,
     THESIS_FULL_DUTY_SPEEDS,
     THESIS_SIMULATED_RMSE_DEG,
 )
-from twin.plants.as_built import CCW_SCALE_BOUND, FULL_DUTY_WINDOW
+from twin.plants.as_built import CCW_SCALE_BOUND, FULL_DUTY_SPEED_DIGIT, FULL_DUTY_WINDOW
 from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import plt
@@ -350,7 +349,7 @@ def full_duty_runs(cases: Sequence[tuple]) -> list[dict]:
 
 def full_duty_rows() -> list[dict]:
     """§4.5.1's measured rack speeds against the twin's (a check: the thesis gives only the range's two ends,
-    each to :data:`THESIS_FULL_DUTY_SPEED_DIGIT`, and which pressure each came at is inferred). Per end of the
+    each to :data:`FULL_DUTY_SPEED_DIGIT`, and which pressure each came at is inferred). Per end of the
     range: the supply, the measured speed and the interval its printed digit allows, and :func:`full_duty_runs`
     for each of :data:`FULL_DUTY_PLANTS` and for as-built without its CCW friction (``runs``), and, when
     as-built's run has both speeds, its slowest (or fastest) way (``way``, 0 CW or 1 CCW, else None) and that
@@ -364,8 +363,8 @@ def full_duty_rows() -> list[dict]:
     rows = []
     for pressure, measured, end in THESIS_FULL_DUTY_SPEEDS:
         row = {"pressure": pressure, "measured": measured, "end": end,
-               "interval": (measured - THESIS_FULL_DUTY_SPEED_DIGIT / 2,
-                            measured + THESIS_FULL_DUTY_SPEED_DIGIT / 2),
+               "interval": (measured - FULL_DUTY_SPEED_DIGIT / 2,
+                            measured + FULL_DUTY_SPEED_DIGIT / 2),
                "runs": {name: next(runs) for name in names}}
         built = row["runs"]["as-built"]
         speeds = built["speeds"]
@@ -1357,12 +1356,12 @@ def report(v: Validation) -> str:
     if v.full_duty:
         low, high = (f"{x * 1e3:g}" for x in FULL_DUTY_WINDOW)
         (p_low, s_low, _), (p_high, s_high, _) = THESIS_FULL_DUTY_SPEEDS
-        low_end = (s_low - THESIS_FULL_DUTY_SPEED_DIGIT / 2) * 1e3
+        low_end = (s_low - FULL_DUTY_SPEED_DIGIT / 2) * 1e3
         lines += ["## Full-duty rack speed (§4.5.1; a check)", "",
                   "The force-loss runs started the joint from rest with both valves of the pair at 100 % duty, both "
                   f"ways, at supply pressures from {p_low / 1e3:g} to {p_high / 1e3:g} kPa; the rack ran at "
                   f"{s_low:g} to {s_high:g} m/s. The thesis gives only the range, each end to "
-                  f"{THESIS_FULL_DUTY_SPEED_DIGIT:g} m/s (so each stands for an interval that wide); that its slowest "
+                  f"{FULL_DUTY_SPEED_DIGIT:g} m/s (so each stands for an interval that wide); that its slowest "
                   "end came at the lowest pressure and its fastest at the highest is inferred, and how the rig took "
                   "its speeds it does not say. So this is a check, not a verdict. The twin's run, sensor noise off: "
                   f"from T1's start, 100 % out for {FULL_DUTY_TURN:g} s, then 100 % back; the speed is the mean over "
