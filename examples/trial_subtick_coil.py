@@ -49,10 +49,13 @@ def _coils_subtick(duty, tick, duty_steps, period_ticks, coil):  # pragma: no co
 
 @numba.njit(cache=False)
 def _openings_subtick(coil, substeps, h, tau_on, tau_off, force_ratio, gap_ratio, spring_ratio, omega, zeta, state,
-                      opening):  # pragma: no cover - compiled
+                      opening, live):  # pragma: no cover - compiled
     """As solenoid.tick_openings, with each coil on for the first fraction of the tick's sub-steps."""
     rise, fall = 1.0 - math.exp(-h / tau_on), 1.0 - math.exp(-h / tau_off)
     for a in range(coil.shape[0]):
+        if not live[a]:
+            opening[a, :] = 0.0
+            continue
         for b in range(coil.shape[1]):
             on_steps = int(round(coil[a, b] * substeps))
             i, x, v = state[a, b, 0], state[a, b, 1], state[a, b, 2]

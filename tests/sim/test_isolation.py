@@ -8,6 +8,8 @@ import numpy as np
 
 from twin.envs.runner import run, run_many
 from twin.physics.model import Orientation
+from twin.sim import simulation
+from twin.sim.plant_state import PlantState
 from twin.sim.scenario import Scenario
 
 A = Scenario("ffpva", 1, seed=0)
@@ -45,3 +47,24 @@ def test_batching_does_not_change_a_scenario():
     batch = run_many([Scenario("pva", t, seed=s) for t in (1, 2) for s in (0, 1)])
     single = run(Scenario("pva", 2, seed=1))
     assert _same(batch[3], single)
+
+
+
+def test_an_as_built_batch_whose_ended_runs_stop_gives_the_numbers_of_one_that_runs_them_on(monkeypatch):
+    """In a batch the solenoid valves and chambers of a run that has ended stop being advanced (a
+    saving); every run's numbers are those of a loop that advances them to the batch's end."""
+    batch = [Scenario("smc", 2, plant="as-built", seed=4), Scenario("ffpva", 4, plant="as-built", seed=5),
+             Scenario("pva", 1, plant="as-built", seed=6)]
+    idle = run_many(batch)
+
+    def running_on(**kwargs):
+        return PlantState(**{**kwargs, "idle_after_end": False})
+
+    monkeypatch.setattr(simulation, "PlantState", running_on)
+    on = run_many(batch)
+    fields = ("angle", "duty", "pressure_a", "pressure_b", "supply_pressure", "valve_open", "velocity",
+              "estimated_velocity")
+    for a, b in zip(idle, on, strict=True):
+        assert len(a.trace.angle) == len(b.trace.angle)
+        assert all(np.array_equal(getattr(a.trace, f), getattr(b.trace, f)) for f in fields)
+        assert a.metrics == b.metrics

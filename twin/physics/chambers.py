@@ -93,9 +93,11 @@ class CompressibleCircuit:
 
     def tick(self, *, conductance: np.ndarray, y: np.ndarray, v0: np.ndarray, external_force: np.ndarray,
              stuck: np.ndarray, mass: np.ndarray, h: float,
-             breakaway: Callable[[np.ndarray], np.ndarray]) -> TickForces:
+             breakaway: Callable[[np.ndarray], np.ndarray], live: np.ndarray | None = None) -> TickForces:
         """Advance one physics tick ``h``; ``conductance`` (n, 4) for V1..V4 in m^3/(Pa s),
-        ``breakaway(y)`` the static friction (N) at rack positions y.
+        ``breakaway(y)`` the static friction (N) at rack positions y. Scenarios whose ``live`` (n,) is
+        False (runs that have ended) are not advanced: their state stays, their forces are 0, their
+        velocity and stuck flag those given; None: every scenario is advanced.
 
         Chamber volumes, Coulomb friction and breakaway are taken at the tick's start
         position (the rack moves at most 0.15 mm in a tick: 0.5 % of a chamber); both carry the load
@@ -113,7 +115,8 @@ class CompressibleCircuit:
             np.asarray(mass, dtype=float), np.asarray(external_force, dtype=float), self.source,
             self.area, fp.viscous, h / ch.substeps, ch.substeps, ch.leak_conductance,
             ch.air_fraction * ch.atmospheric_pressure, 1.0 / ch.water_bulk_modulus, ch.atmospheric_pressure,
-            VAPOUR_MARGIN - ch.atmospheric_pressure, self._line is not None, *line, out)
+            VAPOUR_MARGIN - ch.atmospheric_pressure, self._line is not None, *line,
+            np.ones(len(y), dtype=np.bool_) if live is None else np.asarray(live, dtype=np.bool_), out)
         return TickForces(cylinder_a=out[0], cylinder_b=out[1], velocity=out[2], stuck=out[3] > 0.5)
 
 
@@ -142,14 +145,18 @@ def _rack_solve(momentum, v, push, damping, forward, backward, static, stuck):  
 @numba.njit(cache=True)
 def _substeps(pa, pb, ps, q, conductance, va, vb, y, low, high, forward, backward, static, v0, stuck0, mass,
               external, source, area, viscous, delta, n_sub, leak, air, inverse_water, p_atm, floor, has_line,
-              compliance, inertance, resistance, out):  # pragma: no cover - compiled
-    """The sub-steps of one tick for every scenario, in place on pa, pb, ps, q; ``out`` rows: mean piston
-    force A, mean piston force B, final velocity, stuck (0/1). See :class:`CompressibleCircuit`.
+              compliance, inertance, resistance, live, out):  # pragma: no cover - compiled
+    """The sub-steps of one tick for every scenario whose ``live`` is True, in place on pa, pb, ps, q;
+    ``out`` rows: mean piston force A, mean piston force B, final velocity, stuck (0/1); a scenario that
+    is not live keeps its state, with forces 0 and its v0 and stuck. See :class:`CompressibleCircuit`.
 
     A pressure that would fall below the vapour floor is held there and the step re-solved with it
     fixed (so the forces stay consistent with the velocity); at a stroke end the rack does not move
     outwards (MuJoCo's joint limit holds it), so no flow is invented there."""
     for i in range(pa.shape[0]):
+        if not live[i]:
+            out[0, i], out[1, i], out[2, i], out[3, i] = 0.0, 0.0, v0[i], 1.0 if stuck0[i] else 0.0
+            continue
         g1, g2, g3, g4 = conductance[i, 0], conductance[i, 1], conductance[i, 2], conductance[i, 3]
         fill_a, fill_b = g1 + g2 + leak, g3 + g4 + leak
         momentum = mass[i] / delta

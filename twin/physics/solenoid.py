@@ -123,16 +123,21 @@ def _run(coil, periods, h, tau_on, tau_off, force_ratio, gap_ratio, spring_ratio
 
 @numba.njit(cache=True)
 def tick_openings(coil, substeps, h, tau_on, tau_off, force_ratio, gap_ratio, spring_ratio, omega, zeta, state,
-                  opening):  # pragma: no cover - compiled
+                  opening, live):  # pragma: no cover - compiled
     """Every valve through one control tick of ``substeps`` steps of ``h`` with its coil ``coil`` (n, 4)
     held; ``state`` (n, 4, 3) = (i, x, v) in place; ``opening`` (n, 4) = the tick's mean lift x (its
     mean opening area, a fraction of full). The plant's own inertia stands in for the water column.
+    Scenarios whose ``live`` (n,) is False are left as they are, with an opening of 0 (a run that has
+    ended: nobody reads them).
 
     A valve at rest on the stop its coil holds it to (shut with the coil off, open with it on) stays
     there while the magnetic force keeps holding it: those steps advance only the coil current, the
     same arithmetic as :func:`_step`, so the numbers are identical and idle or held valves cost little."""
     rise, fall = 1.0 - math.exp(-h / tau_on), 1.0 - math.exp(-h / tau_off)
     for a in range(coil.shape[0]):
+        if not live[a]:
+            opening[a, :] = 0.0
+            continue
         for b in range(coil.shape[1]):
             s = coil[a, b]
             i, x, v = state[a, b, 0], state[a, b, 1], state[a, b, 2]

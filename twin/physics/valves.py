@@ -106,8 +106,10 @@ class ValveBank:
         self._open[:] = False
         self._conductance[:] = 0.0
 
-    def update(self, tick: int, duty: np.ndarray) -> np.ndarray:
-        """Valve conductances (n, 4) in m^3/(Pa s) at integer ``tick`` for signed ``duty`` (n,) in %."""
+    def update(self, tick: int, duty: np.ndarray, live: np.ndarray | None = None) -> np.ndarray:
+        """Valve conductances (n, 4) in m^3/(Pa s) at integer ``tick`` for signed ``duty`` (n,) in %.
+        ``live`` (n,) bool: the solenoid valves of scenarios where it is False are not advanced (runs that
+        have ended; their conductance is 0); None: every scenario is."""
         p = self.params
         out = np.empty((self.n, 4))
         duty = per_scenario(duty, self.n)  # read unchecked when compiled
@@ -117,7 +119,8 @@ class ValveBank:
             _solenoid_coils(duty, int(tick), self.duty_steps, self.period_ticks, coil)
             solenoid.tick_openings(coil, self.substeps, self.tick / self.substeps, s.coil_time_constant_on,
                                    s.coil_time_constant_off, s.force_ratio, s.gap_ratio, s.spring_ratio,
-                                   s.natural_frequency, s.damping_ratio, self._plunger, out)
+                                   s.natural_frequency, s.damping_ratio, self._plunger, out,
+                                   np.ones(self.n, dtype=np.bool_) if live is None else live)
             return out * self.full_conductance
         _valve_tick(duty, int(tick), self.duty_steps, self.period_ticks, self.model is ValveModel.AVERAGED,
                     float(p.dead_zone_duty), bool(p.supply_held_in_dead_zone),

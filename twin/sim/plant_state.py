@@ -85,13 +85,17 @@ class PlantState:
 
     ``lengths[i]`` is scenario i's number of ticks; its noise at tick k depends
     only on its seed and k, not on its batch or its length;
-    ``initial_position`` (n,) is where each rack starts at rest (m).
+    ``initial_position`` (n,) is where each rack starts at rest (m). With ``idle_after_end`` a
+    scenario's solenoid valves and chambers are no longer advanced from tick ``lengths[i]`` on (a batch
+    whose runs end at their lengths: nobody reads them after that, and every scenario's numbers are its
+    own, so the others' are unchanged); without it they run for as long as the loop ticks.
     """
 
     def __init__(self, *, scenarios: Sequence[Scenario], joints: Sequence[JointModel], lengths: Sequence[int],
-                 initial_position: np.ndarray, tick: float):
+                 initial_position: np.ndarray, tick: float, idle_after_end: bool = False):
         n = len(scenarios)
         self.n, self.tick = n, tick
+        self._ends = np.asarray(lengths, dtype=np.int64) if idle_after_end else None
         self.plants: list[Plant] = [s.preset for s in scenarios]
         self.supply = np.array([s.supply for s in scenarios])  # Pa
         self.mass = np.array([j.effective_mass for j in joints])  # kg
@@ -162,9 +166,11 @@ class PlantState:
                 external: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Piston forces (cylinder A, cylinder B) in N for the duty command (n,) in %."""
         force_a, force_b = np.zeros(self.n), np.zeros(self.n)
+        live = None if self._ends is None else k < self._ends
         for group in self._plant_groups:
             idx, params = group.selector, group.preset.params
-            self.conductance[idx] = group.valves.update(k, duty[idx])
+            group_live = None if live is None else live[idx]
+            self.conductance[idx] = group.valves.update(k, duty[idx], group_live)
             area = params.cylinder.bore_area
             if group.chambers is None:
                 forces = hydraulics.rack_step(
@@ -176,7 +182,8 @@ class PlantState:
             else:
                 forces = group.chambers.tick(
                     conductance=self.conductance[idx], y=y[idx], v0=v[idx], external_force=external[idx],
-                    stuck=self.stuck[idx], mass=self.mass[idx], h=self.tick, breakaway=group.breakaway)
+                    stuck=self.stuck[idx], mass=self.mass[idx], h=self.tick, breakaway=group.breakaway,
+                    live=group_live)
                 state = group.chambers.state
                 self.pressure_a[idx], self.pressure_b[idx] = state.pressure_a, state.pressure_b
                 self.supply_now[idx] = state.supply_pressure

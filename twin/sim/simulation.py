@@ -139,7 +139,8 @@ def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller]
         place_on_manifold(qpos[i:i + 1], joint, start[i:i + 1])
     qvel[:] = 0.0
     batch.forward()
-    plant = PlantState(scenarios=scenarios, joints=joints, lengths=lengths, initial_position=start, tick=h)
+    plant = PlantState(scenarios=scenarios, joints=joints, lengths=lengths, initial_position=start, tick=h,
+                       idle_after_end=True)  # traces end at their lengths
 
     if len(controllers) != n:
         raise InvalidScenario(f"{len(controllers)} controllers for {n} scenarios")
