@@ -14,6 +14,7 @@ import time
 
 import pytest
 
+from tests.conftest import twin_in_process
 from twin import cli
 from twin.batch import grid, sweep
 from twin.batch.store import COLUMNS, ResultStore, StaleStore
@@ -101,6 +102,7 @@ def test_an_unreadable_config_is_an_invalid_scenario_naming_the_file(tmp_path, c
         grid.read_toml(tmp_path / bad)
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_chunking_and_workers_do_not_change_numbers(tmp_path):
     points = grid.expand(AXES)
     assert len(make_chunks(points, 1)) != len(make_chunks(points, 2))  # really different batches
@@ -304,6 +306,7 @@ def test_ray_backend_gives_the_same_numbers_as_local(tmp_path):
     assert remote == local
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_cli_writes_tables_and_plot(tmp_path):
     proc = _cli("--controller", "ffpva", "--trajectory", "2", "--payload", "0,13.5", "--seed", "0-1",
                 "--out", "s", cwd=tmp_path)
@@ -384,8 +387,8 @@ def test_cli_refuses_a_store_of_another_version_in_one_line(tmp_path, monkeypatc
 
 
 def test_cli_rejects_a_bad_axis_with_one_line(tmp_path):
-    proc = _cli("--payload", "heavy", "--out", "x", cwd=tmp_path)
-    out, err = proc.communicate(timeout=120)
+    proc = twin_in_process(tmp_path, "sweep", "--payload", "heavy", "--out", "x")
+    err = proc.stderr
     assert proc.returncode == 2
     assert "heavy" in err and len(err.strip().splitlines()) == 1
     assert not (tmp_path / "x").exists()

@@ -12,6 +12,7 @@ import sys
 import numpy as np
 import pytest
 
+from tests.conftest import twin_in_process
 from twin.sim.report import TRACE_COLUMNS
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
@@ -51,6 +52,7 @@ def test_run_json_prints_one_record(tmp_path):
     assert list(tmp_path.iterdir()) == []  # --json alone writes nothing
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_plain_summary_of_a_run_that_ends_moving_says_it_has_no_steady_error(tmp_path):
     proc = twin(tmp_path, "run", "--controller", "smc", "--trajectory", "3", "--seed", "0")
     assert proc.returncode == 0, proc.stderr
@@ -79,7 +81,7 @@ BASE = ["run", "--controller", "ffpva", "--trajectory", "1"]
     (["sweep", "--controller", "ffpva"], "--out"),
 ])
 def test_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, args, bad):
-    proc = twin(tmp_path, *args)
+    proc = twin_in_process(tmp_path, *args)
     assert proc.returncode == 2
     lines = proc.stderr.splitlines()
     assert len(lines) == 1, proc.stderr
@@ -88,6 +90,7 @@ def test_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, args, bad)
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_trace_and_plot_files(tmp_path):
     proc = twin(tmp_path, *BASE, "--seed", "0", "--trace", "out.csv", "--plot", "out.png")
     assert proc.returncode == 0, proc.stderr
@@ -115,10 +118,12 @@ def _trace(tmp_path, *args):
     return np.array([float(r["y_measured_mm"]) - float(r["y_mm"]) for r in rows])
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_no_noise_means_the_sensor_reads_the_true_position(tmp_path):
     assert np.all(_trace(tmp_path, "--no-noise") == 0.0)
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_noise_is_white_within_the_thesis_bound(tmp_path):
     noise = _trace(tmp_path, "--seed", "4")
     assert np.max(np.abs(noise)) <= 0.02 + 1e-6  # mm, SPEC §5 (the CSV keeps 6 digits)
@@ -146,6 +151,7 @@ def test_noise_seed_changes_the_result(tmp_path):
     assert a["rmse_deg"] != b["rmse_deg"]
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_demo_writes_results_and_summary(tmp_path):
     proc = twin(tmp_path, "demo", "--seeds", "1", "--no-plots", "--out", "d")
     assert proc.returncode == 0, proc.stderr
@@ -177,6 +183,6 @@ def test_without_switches_off_as_built_effects_by_name(tmp_path):
     (["--plant", "as-built", "--without", "compressibility"], "supply_line off too"),
 ])
 def test_without_refuses_what_it_cannot_switch_off(tmp_path, args, bad):
-    proc = twin(tmp_path, *BASE, *args, "--json")
+    proc = twin_in_process(tmp_path, *BASE, *args, "--json")
     assert proc.returncode == 2
     assert bad in proc.stderr and len(proc.stderr.strip().splitlines()) == 1 and proc.stdout == ""

@@ -403,6 +403,7 @@ def test_tables_read_cleanly_in_a_spreadsheet(tmp_path):
                    "h": "1.23456789012e-07"}
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, capsys):
     import csv
     import json

@@ -43,6 +43,10 @@ class HoldConformance(test_utils.EnvironmentTestMixin, unittest.TestCase):
         for _ in range(2100):
             yield self.make_action()
 
+    @pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26): the one that runs a whole episode
+    def test_longer_action_sequence(self):
+        super().test_longer_action_sequence()
+
 
 def _episode(environment, policy) -> float:
     timestep = environment.reset()
@@ -56,6 +60,7 @@ def _episode(environment, policy) -> float:
     ("pva", 4, {}),
     ("smc", 3, {"payload": 13.5e-3, "orientation": Orientation.VERTICAL}),
 ])
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_thesis_controllers_as_policies_match_twin_run(name, trajectory, load):
     controller = make_controller(name, nominal=NominalModel.thesis(), gain_set="simulation", tick=1e-3)
     environment = joint_env.load("track", trajectory=trajectory, action_period=controller.period, seed=3,
@@ -68,6 +73,7 @@ def test_thesis_controllers_as_policies_match_twin_run(name, trajectory, load):
     np.testing.assert_array_equal(environment.physics.true_angle[:n], reference.trace.angle)
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_same_seed_same_episodes_and_episodes_differ():
     def first_observations(seed):
         environment = joint_env.load("hold", seed=seed)
@@ -125,6 +131,7 @@ def test_a_policy_at_another_period_than_the_environment_is_refused(name, action
             timestep = environment.step(policy(timestep))
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_random_policy_raises_no_mujoco_warning():
     environment = joint_env.load("hold", seed=11)
     rng = np.random.default_rng(11)

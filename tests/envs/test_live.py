@@ -30,6 +30,7 @@ R_PINION = 3.71e-3 / 2  # m
 
 
 @pytest.mark.parametrize("controller", ["ffpva", "smc"])
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_live_loop_is_the_simulation_loop(controller):
     """Playing the scenario's own trajectory, the live joint gives twin run's numbers exactly."""
     scenario = Scenario(controller, 4, seed=3)

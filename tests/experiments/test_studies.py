@@ -16,6 +16,7 @@ import numpy as np
 import pytest
 
 from controllers.open_loop import ReversingSine
+from tests.conftest import twin_in_process
 from twin.experiments.calibrate import EXPERIMENT_CELLS, Evaluator
 from twin.experiments.studies import ablation, openloop, robustness
 from twin.experiments.studies.openloop import Reversal, paired_reversals, reversal_lags
@@ -260,6 +261,7 @@ def twin(cwd: pathlib.Path, *args: str) -> subprocess.CompletedProcess:
                           text=True, encoding="utf-8", timeout=300)
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_cli_openloop_writes_the_csv_and_the_figure(tmp_path):
     proc = twin(tmp_path, "study", "openloop", "--out", "ol")
     assert proc.returncode == 0, proc.stderr
@@ -307,7 +309,7 @@ def test_cli_ablation_writes_every_variant_and_cell(tmp_path):
     (["study", "sideways", "--out", "x"], "sideways"),
 ])
 def test_cli_bad_input_exits_2_with_one_line_and_writes_nothing(tmp_path, args, bad):
-    proc = twin(tmp_path, *args)
+    proc = twin_in_process(tmp_path, *args)
     assert proc.returncode == 2
     lines = proc.stderr.splitlines()
     assert len(lines) == 1 and lines[0].startswith("twin"), proc.stderr

@@ -736,3 +736,25 @@ def test_every_ensemble_member_breaks_away_both_ways_at_245_kpa_as_the_force_los
     for plant, run in zip(plants, runs, strict=True):
         cw, ccw = run["speeds"]
         assert run["warnings"] == 0 and 0.0 < ccw <= cw < 0.1, (plant.name, run)
+
+
+def test_report_says_on_how_many_members_each_controller_order_is_right():
+    members = [{"stiction": 1.0, "load_friction": 0.15, "observer_gain": 340.0},
+               {"stiction": 2.2, "load_friction": 0.45, "observer_gain": 340.0}]
+    v = _fake(1.0, lag_within=True, stalled=0, members=members)
+    rig = "sliding mode < FF + PVA < PVA + DZC"  # both trajectories' measured order
+    v.prediction_detail["orders"] = [{1: rig, 2: "FF + PVA < PVA + DZC < sliding mode"}, {1: rig, 2: rig}]
+    assert validate.member_orders(v.prediction_detail, {1: rig, 2: rig}) == {1: [0, 1], 2: [1]}
+    text = validate.report(v)
+    assert "T1 right on 2; T2 right on 1. T2's is right on 1 of the ensemble's 2 members (load friction 0.45 N/N and " \
+           "breakaway 2.20 N and observer gain 340 1/s)." in text
+    assert "the twin does not settle T2's order" in text
+    order = next(m for m in validate.misses(v) if m["comparison"] == "controller order")
+    assert order["trajectory"] == 2 and order["what_the_twin_shows"].endswith(
+        "; seeds 0-4 put it right on 1 of the ensemble's 2 members (load friction 0.45 N/N and breakaway 2.20 N and "
+        "observer gain 340 1/s)")
+    v.prediction_detail["orders"] = [{1: rig, 2: rig}, {1: rig, 2: rig}]
+    assert "Each order is the same on every member" in validate.report(v)
+    del v.prediction_detail["orders"]  # a detail from before the members ran the Chapter 5 cells
+    assert "across the ensemble" not in validate.report(v) and "ensemble's" not in validate.misses(v)[-1][
+        "what_the_twin_shows"]

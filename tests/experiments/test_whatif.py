@@ -185,6 +185,7 @@ def test_supply_variants_differ_in_the_supply_alone_and_sag_as_their_compliance_
     assert 0 < accumulator_dip < line_dip
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_whatif_supply_writes_its_answer_and_refuses_a_plant_with_a_constant_supply(tmp_path, capsys):
     out = tmp_path / "supply"
     rows = _whatif_rows(out, "supply", "--seeds", "1")
@@ -196,6 +197,7 @@ def test_whatif_supply_writes_its_answer_and_refuses_a_plant_with_a_constant_sup
     assert "holds its supply constant" in capsys.readouterr().err and not never.exists()
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_smc_phi_changes_phi_alone_and_reports_against_the_measurements():
     """At the thesis's phi the what-if's sliding mode is the thesis's controller to the last bit, and its FF + PVA
     the thesis's too (both against plain runs of the same cells and seed), on every cell sliding mode was measured
@@ -260,6 +262,7 @@ def test_smc_phi_answer_counts_the_cells_within_tolerance_and_ahead():
             "at 0.2 m/s.") in answer(chapter5, phi=0.3, seeds=3, plant_name="as-built")
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_whatif_smc_phi_cli_writes_its_table_and_plot(tmp_path):
     out = tmp_path / "phi"
     rows = _whatif_rows(out, "smc-phi", "--seeds", "1", "--phis", "0.3")

@@ -505,6 +505,7 @@ def thesis_t4() -> Callable[[str], Result]:
 
 
 @pytest.mark.parametrize("controller", ["pva", "ffpva", "smc"])
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_all_effects_off_is_the_thesis_plant(controller, thesis_t4):
     bare = as_built_plant(VALUES, without=EFFECTS)
     assert bare.params == PLANTS["thesis"].params

@@ -5,6 +5,7 @@ from __future__ import annotations
 import concurrent.futures
 
 import numpy as np
+import pytest
 
 from twin.envs.runner import run, run_many
 from twin.physics.model import Orientation
@@ -29,6 +30,7 @@ def test_different_seeds_give_different_noise():
     assert not np.array_equal(run(A).trace.measured_position, run(Scenario("ffpva", 1, seed=1)).trace.measured_position)
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_two_twins_with_different_models_do_not_cross_talk():
     alone_a, alone_b = run(A), run(B)
     together = run_many([A, B])
@@ -36,6 +38,7 @@ def test_two_twins_with_different_models_do_not_cross_talk():
     assert _same(alone_a, run(A))  # nothing left behind by B
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)
 def test_two_twins_in_parallel_threads_match_each_alone():
     alone_a, alone_b = run(A), run(B)
     with concurrent.futures.ThreadPoolExecutor(max_workers=2) as pool:
@@ -53,8 +56,8 @@ def test_batching_does_not_change_a_scenario():
 def test_an_as_built_batch_whose_ended_runs_stop_gives_the_numbers_of_one_that_runs_them_on(monkeypatch):
     """In a batch the solenoid valves and chambers of a run that has ended stop being advanced (a
     saving); every run's numbers are those of a loop that advances them to the batch's end."""
-    batch = [Scenario("smc", 2, plant="as-built", seed=4), Scenario("ffpva", 4, plant="as-built", seed=5),
-             Scenario("pva", 1, plant="as-built", seed=6)]
+    batch = [Scenario("smc", 2, plant="as-built", seed=4), Scenario("ffpva", 1, plant="as-built", seed=5),
+             Scenario("pva", 2, plant="as-built", seed=6)]  # 1 s, 3 s, 1 s
     idle = run_many(batch)
 
     def running_on(**kwargs):

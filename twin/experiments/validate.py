@@ -607,9 +607,11 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     from twin.plants.as_built import ensemble_values
 
     members = ensemble_values()
-    per_member = []
-    for values in members:
-        per_member.append(evaluator.cells(values, keys=PREDICTION_CELLS))
+    per_member, experiment = [], []
+    for values in members:  # with the Chapter 5 cells, to show which of the members puts each order right
+        cells = evaluator.cells(values, keys=PREDICTION_CELLS + calibrate.EXPERIMENT_CELLS)
+        per_member.append(cells[:len(PREDICTION_CELLS)])
+        experiment.append(cells[len(PREDICTION_CELLS):])
         if progress:
             progress()
     own = next((cells for values, cells in zip(members, per_member, strict=True) if values == committed), None)
@@ -622,8 +624,30 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
                      "twin_mean": own[k].mean_rmse, "band_p10": p10, "band_p50": p50, "band_p90": p90,
                      "stalled_runs": sum(stalled_runs(m[k]) for m in per_member)})
     detail = {"members": members, "runs": len(members) * len(SEEDS),
-              "per_member": [[c.mean_rmse for c in m] for m in per_member]}
+              "per_member": [[c.mean_rmse for c in m] for m in per_member],
+              "orders": [_order([{"controller": c.controller, "trajectory": c.trajectory, "twin_mean": c.mean_rmse}
+                                 for c in m if math.isfinite(c.mean_rmse)], "twin_mean") for m in experiment]}
     return rows, own, detail
+
+
+def member_orders(detail: dict, measured: dict[int, str]) -> dict[int, list[int]]:
+    """Per trajectory of ``measured`` (its controller order), the ensemble members (their places in
+    ``detail["members"]``) whose Chapter 5 runs put the controllers in that order; {} when ``prediction``'s
+    detail has no orders."""
+    orders = detail.get("orders")
+    if not orders:
+        return {}
+    return {t: [k for k, order in enumerate(orders) if order.get(t) == rig] for t, rig in measured.items()}
+
+
+def _members_right_text(detail: dict, t: int, right: Sequence[int]) -> str:
+    """How many members put trajectory ``t``'s order right, and which (by the parameters they differ in)."""
+    members = detail["members"]
+    text = f"right on {len(right)} of the ensemble's {len(members)} members"
+    if 0 < len(right) < len(members):
+        names = _profiled(members)
+        text += " (" + "; ".join(_member_text(members[k], names) for k in right) + ")"
+    return text
 
 
 def member_means(detail: dict) -> np.ndarray:
@@ -1023,6 +1047,9 @@ def misses(v: Validation) -> list[dict]:
         else:
             reading = "open"
             text = f"every cell of T{t} is within {RMSE_TOLERANCE * 100:.0f} %: the order turns on differences inside it"
+        right_members = member_orders(v.prediction_detail, rig).get(t)
+        if right_members is not None:
+            text += "; seeds 0-4 put it " + _members_right_text(v.prediction_detail, t, right_members)
         order_row = {"controller": None, "trajectory": t, "payload_g": 0.0, "orientation": "horizontal",
                      "within_tolerance": rig[t] == twin[t]}
         add("controller order", order_row, None, rig[t], twin[t], None,
@@ -1111,6 +1138,19 @@ def _why(v: Validation) -> list[str]:
                  f"{len(same)} of {len(measured)} trajectories. "
                  + "; ".join(f"T{t}: measured {measured[t]}, twin {twin[t]}" for t in measured if t not in same)
                  + ("." if len(same) < len(measured) else ""))
+    by_member = member_orders(v.prediction_detail, measured)
+    if by_member:
+        count = len(v.prediction_detail["members"])
+        split = [t for t, right in by_member.items() if 0 < len(right) < count]
+        lines.append(
+            f"- **Controller order across the ensemble** (Chapter 5 experiments, seeds 0-4, each of the {count} "
+            "members that fit the measurements about equally well): "
+            + "; ".join(f"T{t} right on {len(right)}" for t, right in by_member.items()) + ". "
+            + (" ".join(f"T{t}'s is {_members_right_text(v.prediction_detail, t, by_member[t])}." for t in split)
+               + " So within what the data allow the twin does not settle " + " and ".join(f"T{t}'s" for t in split)
+               + " order: it comes out right on some members and wrong on others, and the committed preset's "
+               "order there is one of them, not a finding." if split else
+               "Each order is the same on every member: the parameters the data do not pin do not turn it."))
     parts = v.sliding_mode
     if parts and parts["trajectories"]:
         ts = sorted(parts["trajectories"])

@@ -1,0 +1,50 @@
+"""Trial (not installed): what stopping the hydraulics of a batch's ended runs saves, as a ratio in one run.
+
+A batch steps every scenario's solenoid valves and chambers each tick; since 2026-11-26 a run that has
+ended (its trace is cut at its length) is no longer advanced (``PlantState(idle_after_end=True)``, which
+``twin.sim.simulation.simulate`` asks for). This script times one calibration worker's share of an
+evaluation (the 21 fitted cells x 5 seeds in one batch: 13 of the cells are 3 s T1 runs beside 6 s T4 ones)
+with the ended runs idle and with them run on to the batch's end, alternately, ``REPEATS`` times each, and
+prints the times, their ratio (fastest over fastest) and whether every RMSE is the same bits.
+
+    python examples/trial_idle_after_end.py
+"""
+
+from __future__ import annotations
+
+import time
+
+import twin.sim.simulation as simulation
+from twin.experiments import calibrate
+from twin.plants.as_built import calibrated_values
+from twin.sim.plant_state import PlantState
+
+REPEATS = 3
+SEEDS = range(5)
+
+
+def running_on(**kwargs) -> PlantState:
+    return PlantState(**{**kwargs, "idle_after_end": False})
+
+
+def main() -> None:
+    values = calibrated_values()
+    jobs = [(*key, seed) for key in calibrate.CELLS for seed in SEEDS]
+    calibrate._run_cells(values, jobs[:len(calibrate.CELLS)])  # compile and build the models once
+    times: dict[str, list[float]] = {"idle": [], "run on": []}
+    rmse = {}
+    for _ in range(REPEATS):
+        for name, factory in (("run on", running_on), ("idle", PlantState)):
+            simulation.PlantState = factory
+            started = time.perf_counter()
+            rows = calibrate._run_cells(values, jobs)
+            times[name].append(time.perf_counter() - started)
+            rmse[name] = [row[5] for row in rows]
+    simulation.PlantState = PlantState
+    print({name: [round(t, 2) for t in ts] for name, ts in times.items()})
+    print(f"run on / idle (fastest of {REPEATS}): {min(times['run on']) / min(times['idle']):.2f}; "
+          f"same RMSE bits: {rmse['idle'] == rmse['run on']}")
+
+
+if __name__ == "__main__":
+    main()
