@@ -755,6 +755,21 @@ def test_report_says_on_how_many_members_each_controller_order_is_right():
         "observer gain 340 1/s)")
     v.prediction_detail["orders"] = [{1: rig, 2: rig}, {1: rig, 2: rig}]
     assert "Each order is the same on every member" in validate.report(v)
+    pva1 = ("pva", 1, 0.0, "horizontal")  # measured 4.2; the committed preset's x0.4 misses
+    v.prediction_detail["fitted_means"] = [{pva1: 1.68}, {pva1: 3.6}]
+    miss = next(m for m in validate.misses(v) if m["comparison"] == "RMSE" and m["controller"] == "pva")
+    assert miss["what_the_twin_shows"].endswith("; within on 1 of the ensemble's 2 members (seeds 0-4; x0.40-x0.86)")
+    v.prediction_detail["fitted_means"] = [{pva1: math.nan}, {pva1: math.nan}]
+    miss = next(m for m in validate.misses(v) if m["comparison"] == "RMSE" and m["controller"] == "pva")
+    assert miss["what_the_twin_shows"].endswith("; within on 0 of the ensemble's 2 members (seeds 0-4)")
+    pva2 = ("pva", 2, 0.0, "horizontal")  # measured 2.93; committed x0.75, out
+    v.prediction_detail["fitted_means"] = [{pva1: 1.68, pva2: 2.2}, {pva1: 3.6, pva2: 2.2}]
+    assert ("- **The misses on every member** (the 2 ensemble members, seeds 0-4): each puts 0-1 of the 7 measured "
+            "RMSE cells within 20 % (the committed preset 4; members in order: 0, 1). Out on every member, so not a "
+            "matter of which of the equally good fits is committed: PVA + DZC T2. Out on the committed preset but "
+            "within on some member: PVA + DZC T1.") in validate.report(v)
+    del v.prediction_detail["fitted_means"]
+    assert "The misses on every member" not in validate.report(v)
     del v.prediction_detail["orders"]  # a detail from before the members ran the Chapter 5 cells
     assert "across the ensemble" not in validate.report(v) and "ensemble's" not in validate.misses(v)[-1][
         "what_the_twin_shows"]

@@ -607,13 +607,14 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     from twin.plants.as_built import ensemble_values
 
     members = ensemble_values()
-    per_member, experiment = [], []
-    for values in members:  # with the Chapter 5 cells, to show which of the members puts each order right
-        cells = evaluator.cells(values, keys=PREDICTION_CELLS + calibrate.EXPERIMENT_CELLS)
+    per_member, fitted = [], []
+    for values in members:  # with the fitted cells: how each miss and each order fares on every member
+        cells = evaluator.cells(values, keys=PREDICTION_CELLS + calibrate.CELLS)
         per_member.append(cells[:len(PREDICTION_CELLS)])
-        experiment.append(cells[len(PREDICTION_CELLS):])
+        fitted.append(cells[len(PREDICTION_CELLS):])
         if progress:
             progress()
+    experiment = [[c for c in m if c.key in calibrate.EXPERIMENT_CELLS] for m in fitted]
     own = next((cells for values, cells in zip(members, per_member, strict=True) if values == committed), None)
     own = own or evaluator.cells(committed, keys=PREDICTION_CELLS)
     rows = []
@@ -626,8 +627,47 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     detail = {"members": members, "runs": len(members) * len(SEEDS),
               "per_member": [[c.mean_rmse for c in m] for m in per_member],
               "orders": [_order([{"controller": c.controller, "trajectory": c.trajectory, "twin_mean": c.mean_rmse}
-                                 for c in m if math.isfinite(c.mean_rmse)], "twin_mean") for m in experiment]}
+                                 for c in m if math.isfinite(c.mean_rmse)], "twin_mean") for m in experiment],
+              "fitted_means": [{c.key: c.mean_rmse for c in m} for m in fitted]}
     return rows, own, detail
+
+
+def _why_members(v: Validation) -> list[str]:
+    """How many of the measured RMSE cells each ensemble member puts within tolerance, and which cells are
+    out on every member ([] when the members did not run them)."""
+    means = v.prediction_detail.get("fitted_means")
+    rows = [r for r in v.rows if r["source"] in ("chapter 5 experiment", "chapter 6 T1")]
+    if not means or not rows:
+        return []
+
+    def within(m: dict, r: dict) -> bool | None:
+        x = m.get((r["controller"], r["trajectory"], r["payload_g"], r["orientation"]))
+        return None if x is None else bool(abs(x / r["measured"] - 1.0) <= RMSE_TOLERANCE)
+
+    counts = [sum(within(m, r) is True for r in rows) for m in means]
+    everywhere = [r for r in rows if all(within(m, r) is False for m in means)]
+    some = [r for r in rows if not r["within_tolerance"] and any(within(m, r) is True for m in means)]
+    return [f"- **The misses on every member** (the {len(means)} ensemble members, seeds 0-4): each puts "
+            f"{min(counts)}-{max(counts)} of the {len(rows)} measured RMSE cells within {RMSE_TOLERANCE * 100:.0f} % "
+            f"(the committed preset {sum(bool(r['within_tolerance']) for r in rows)}; members in order: "
+            + ", ".join(str(c) for c in counts) + "). "
+            + (("Out on every member, so not a matter of which of the equally good fits is committed: "
+                + ", ".join(_cell_name(r) for r in everywhere) + ". ") if everywhere else "")
+            + (("Out on the committed preset but within on some member: " + ", ".join(_cell_name(r) for r in some)
+                + ".") if some else "No cell the committed preset misses is within on any member.")]
+
+
+def _members_within_text(detail: dict, r: dict) -> str:
+    """On how many ensemble members the measured cell ``r`` (a validation row) is within tolerance, and
+    the span of their ratios; "" when ``prediction``'s detail has no member means for it."""
+    key = (r["controller"], r["trajectory"], r["payload_g"], r["orientation"])
+    means = [m[key] for m in detail.get("fitted_means") or [] if key in m]
+    if not means:
+        return ""
+    ratios = [x / r["measured"] for x in means if math.isfinite(x)]  # a member whose runs failed has none
+    within = sum(abs(x - 1.0) <= RMSE_TOLERANCE for x in ratios)
+    span = f"; x{min(ratios):.2f}-x{max(ratios):.2f}" if ratios else ""
+    return f"; within on {within} of the ensemble's {len(means)} members (seeds 0-4{span})"
 
 
 def member_orders(detail: dict, measured: dict[int, str]) -> dict[int, list[int]]:
@@ -1010,8 +1050,10 @@ def misses(v: Validation) -> list[dict]:
         f = fresh.get(tuple(r[k] for k in key))
         if r["source"] in ("chapter 5 experiment", "chapter 6 T1"):
             if not r["within_tolerance"] or (f and not f["within_tolerance"]):
+                reading, text = _rmse_reading(r, f, v, experiment)
                 add("RMSE", r, f, r["measured"], r["twin_mean"], r["ratio"], f and f["ratio"],
-                    f and f["within_tolerance"], f and f["groups_within"], *_rmse_reading(r, f, v, experiment))
+                    f and f["within_tolerance"], f and f["groups_within"], reading,
+                    text + _members_within_text(v.prediction_detail, r))
     for r in v.rows:
         f = fresh.get(tuple(r[k] for k in key))
         judged = f is not None and f["sse_twin"] is not None
@@ -1138,6 +1180,7 @@ def _why(v: Validation) -> list[str]:
                  f"{len(same)} of {len(measured)} trajectories. "
                  + "; ".join(f"T{t}: measured {measured[t]}, twin {twin[t]}" for t in measured if t not in same)
                  + ("." if len(same) < len(measured) else ""))
+    lines += _why_members(v)
     by_member = member_orders(v.prediction_detail, measured)
     if by_member:
         count = len(v.prediction_detail["members"])
