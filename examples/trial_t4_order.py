@@ -1,0 +1,36 @@
+"""Trial (not installed): Chapter 5's T4 controller order on every calibration ensemble member.
+
+The rig tracked T4 with sliding mode ahead of FF + PVA (1.82 against 1.95 deg); the committed preset
+puts FF + PVA ahead. This script runs both on T4 (0 g, horizontal) for each member of the committed
+calibration's ensemble, on seeds 0-4 (the verdict's) and on seeds 40-79 (which no step of the fit
+ran), and prints the members' profiled values and the four means. Its result (2026-11-26) is in
+docs/as-built.md.
+
+    python examples/trial_t4_order.py
+"""
+
+from __future__ import annotations
+
+from twin.experiments import calibrate
+from twin.plants.as_built import ensemble_values
+
+KEYS = [("ffpva", 4, 0.0, "horizontal"), ("smc", 4, 0.0, "horizontal")]
+FRESH = tuple(range(40, 80))
+
+
+def main() -> None:
+    evaluator = calibrate.Evaluator(seeds=tuple(range(5)), workers=2)
+    try:
+        for k, m in enumerate(ensemble_values()):
+            five = evaluator.cells(m, keys=KEYS)
+            fresh = evaluator.cells(m, keys=KEYS, seeds=FRESH)
+            print(f"{k} CCW {m['ccw_coulomb_scale']:.3f} load {m['load_friction']:.2f} K_OB {m['observer_gain']:.0f} "
+                  f"leak {m['leak_conductance'] * 1e14:.2f}e-14 | seeds 0-4: FF + PVA {five[0].mean_rmse:.3f}, "
+                  f"SMC {five[1].mean_rmse:.3f} | seeds 40-79: FF + PVA {fresh[0].mean_rmse:.3f}, "
+                  f"SMC {fresh[1].mean_rmse:.3f}", flush=True)
+    finally:
+        evaluator.close()
+
+
+if __name__ == "__main__":
+    main()
