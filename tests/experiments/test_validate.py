@@ -773,3 +773,31 @@ def test_report_says_on_how_many_members_each_controller_order_is_right():
     del v.prediction_detail["orders"]  # a detail from before the members ran the Chapter 5 cells
     assert "across the ensemble" not in validate.report(v) and "ensemble's" not in validate.misses(v)[-1][
         "what_the_twin_shows"]
+
+
+def test_payload_phases_split_each_runs_squared_error_between_the_move_and_the_hold(monkeypatch):
+    """On one run per cell the move's and the hold's mean squared errors, weighted by their ticks (1 s and 2 s
+    of T1), make up the run's RMSE."""
+    from twin.plants.as_built import calibrated_values
+
+    monkeypatch.setattr(validate, "SEEDS", (3,))
+    rows = validate.payload_phases(calibrated_values())
+    assert {(r["controller"], r["payload_g"], r["orientation"]) for r in rows} == {
+        (c, g, o) for c in ("ffpva", "smc") for g in (0.0, 6.5, 13.5) for o in ("horizontal", "vertical")}
+    for r in rows:
+        assert r["move_end_s"] == 1.0 and r["failed_runs"] == 0
+        assert math.sqrt((1000 * r["move_deg"] ** 2 + 2000 * r["hold_deg"] ** 2) / 3000) == pytest.approx(
+            r["rmse_deg"], rel=1e-9)
+
+
+def test_report_says_where_in_t1_the_payload_costs_fall():
+    v = _fake(1.0, lag_within=True, stalled=0)
+    v.phases = [{"controller": "smc", "payload_g": g, "orientation": o, "rmse_deg": rmse, "move_deg": move,
+                 "hold_deg": hold, "move_end_s": 1.0, "failed_runs": 0}
+                for g, o, rmse, move, hold in ((0.0, "horizontal", 1.3, 2.0, 0.5), (13.5, "vertical", 3.5, 6.0, 1.0))]
+    text = validate.report(v)
+    assert ("sliding mode move x3.00, hold x2.00, RMSE x2.69 (13.5 g V). The thesis gives each run's RMSE over the "
+            "whole of it") in text
+    assert "| sliding mode | 13.5 g | vertical | 3.48 | 3.50 | 6.00 | 1.00 |" in text
+    v.phases = None
+    assert "Where in T1" not in validate.report(v)
