@@ -9,6 +9,7 @@ import math
 import os
 import pathlib
 import subprocess
+import sys
 
 import pytest
 
@@ -81,7 +82,8 @@ def listening_addresses(port: int) -> set[str]:
 def twin_in_process(cwd: pathlib.Path, *args: str) -> subprocess.CompletedProcess:
     """``twin ARGS`` in ``cwd``, run by :func:`twin.cli.main` in this process: for refusals, which must
     exit 2 with one line before running anything, without paying a new interpreter's imports (1.5-2 s a
-    call). Runs that go through the installed entry point use each file's subprocess form."""
+    call). Runs that go through the installed entry point use each file's subprocess form. Unlike a new
+    interpreter it does not see Python's warnings on stderr (pytest collects them)."""
     from twin.cli import main
 
     out, err, here = io.StringIO(), io.StringIO(), os.getcwd()
@@ -90,8 +92,12 @@ def twin_in_process(cwd: pathlib.Path, *args: str) -> subprocess.CompletedProces
         with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
             try:
                 code = main(list(args))
-            except SystemExit as stop:  # argparse's refusals
-                code = stop.code if isinstance(stop.code, int) else 1
+            except SystemExit as stop:  # argparse's refusals; otherwise as the interpreter reads sys.exit's code
+                if stop.code is None or isinstance(stop.code, int):
+                    code = stop.code or 0
+                else:
+                    print(stop.code, file=sys.stderr)
+                    code = 1
     finally:
         os.chdir(here)
     return subprocess.CompletedProcess(["twin", *args], code, out.getvalue(), err.getvalue())

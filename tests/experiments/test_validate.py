@@ -754,7 +754,10 @@ def test_report_says_on_how_many_members_each_controller_order_is_right():
         "; seeds 0-4 put it right on 1 of the ensemble's 2 members (load friction 0.45 N/N and breakaway 2.20 N and "
         "observer gain 340 1/s)")
     v.prediction_detail["orders"] = [{1: rig, 2: rig}, {1: rig, 2: rig}]
-    assert "Each order is the same on every member" in validate.report(v)
+    assert "Each order is right on every member or on none" in validate.report(v)
+    v.prediction_detail["orders"] = [{1: rig, 2: None}, {1: rig, 2: rig}]  # member 0's T2 runs failed
+    assert "right on 1 of the ensemble's 2 members (1 without an order: a run failed)" in validate.misses(v)[-1][
+        "what_the_twin_shows"]
     pva1 = ("pva", 1, 0.0, "horizontal")  # measured 4.2; the committed preset's x0.4 misses
     v.prediction_detail["fitted_means"] = [{pva1: 1.68}, {pva1: 3.6}]
     miss = next(m for m in validate.misses(v) if m["comparison"] == "RMSE" and m["controller"] == "pva")
@@ -801,3 +804,37 @@ def test_report_says_where_in_t1_the_payload_costs_fall():
     assert "| sliding mode | 13.5 g | vertical | 3.48 | 3.50 | 6.00 | 1.00 |" in text
     v.phases = None
     assert "Where in T1" not in validate.report(v)
+
+
+def test_prediction_runs_each_cell_once_per_member_and_keeps_every_fitted_cell():
+    """T3's 0 g flat cells are both predicted and fitted: run once, so no run is counted twice."""
+    from twin.experiments.calibrate import CELLS, CellResult
+    from twin.plants.as_built import ensemble_values
+
+    asked = []
+
+    class Recording:
+        def cells(self, values, *, keys, seeds=None):
+            asked.append(tuple(keys))
+            return [CellResult(k[0], k[1], (1.0,) * 5, (0.0,) * 5, seeds=tuple(range(5)), payload_g=k[2],
+                               orientation=k[3]) for k in keys]
+
+    members = ensemble_values()
+    rows, own, detail = validate.prediction(Recording(), members[0])
+    assert len(asked) == len(members) and all(len(set(keys)) == len(keys) for keys in asked)
+    assert [len(c.rmse_deg) for c in own] == [5] * len(validate.PREDICTION_CELLS)
+    assert all(set(m) == set(CELLS) for m in detail["fitted_means"])
+    assert all(set(order) == {1, 2, 3, 4} for order in detail["orders"])
+
+
+def test_a_member_without_a_mean_is_not_counted_out_or_in():
+    from twin.experiments.calibrate import CellResult
+
+    cells = [CellResult(c, t, (x,) * 5, (0.0,) * 5, seeds=tuple(range(5)))
+             for c, t, x in (("ffpva", 1, 1.2), ("smc", 1, 1.1), ("ffpva", 2, math.nan), ("smc", 2, 1.5))]
+    assert validate._known_orders(cells) == {1: "sliding mode < FF + PVA", 2: None}
+    v = _fake(1.0, lag_within=True, stalled=0)
+    pva2 = ("pva", 2, 0.0, "horizontal")  # committed x0.75, out
+    v.prediction_detail["fitted_means"] = [{pva2: math.nan}, {pva2: 2.2}]
+    line = next(x for x in validate._why_members(v))
+    assert "Out on every member" not in line  # one member has no mean: not known to be out there

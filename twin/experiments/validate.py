@@ -641,11 +641,14 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     from twin.plants.as_built import ensemble_values
 
     members = ensemble_values()
+    # With the fitted cells: how each miss and each order fares on every member. Each cell runs once (T3's
+    # 0 g flat cells are both predicted and fitted) and is picked by its key.
+    keys = PREDICTION_CELLS + tuple(key for key in calibrate.CELLS if key not in PREDICTION_CELLS)
     per_member, fitted = [], []
-    for values in members:  # with the fitted cells: how each miss and each order fares on every member
-        cells = evaluator.cells(values, keys=PREDICTION_CELLS + calibrate.CELLS)
-        per_member.append(cells[:len(PREDICTION_CELLS)])
-        fitted.append(cells[len(PREDICTION_CELLS):])
+    for values in members:
+        found = {cell.key: cell for cell in evaluator.cells(values, keys=keys)}
+        per_member.append([found[key] for key in PREDICTION_CELLS])
+        fitted.append([found[key] for key in calibrate.CELLS])
         if progress:
             progress()
     experiment = [[c for c in m if c.key in calibrate.EXPERIMENT_CELLS] for m in fitted]
@@ -660,8 +663,7 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
                      "stalled_runs": sum(stalled_runs(m[k]) for m in per_member)})
     detail = {"members": members, "runs": len(members) * len(SEEDS),
               "per_member": [[c.mean_rmse for c in m] for m in per_member],
-              "orders": [_order([{"controller": c.controller, "trajectory": c.trajectory, "twin_mean": c.mean_rmse}
-                                 for c in m if math.isfinite(c.mean_rmse)], "twin_mean") for m in experiment],
+              "orders": [_known_orders(m) for m in experiment],
               "fitted_means": [{c.key: c.mean_rmse for c in m} for m in fitted]}
     return rows, own, detail
 
@@ -674,9 +676,9 @@ def _why_members(v: Validation) -> list[str]:
     if not means or not rows:
         return []
 
-    def within(m: dict, r: dict) -> bool | None:
+    def within(m: dict, r: dict) -> bool | None:  # None: not run, or no mean (a failed run)
         x = m.get((r["controller"], r["trajectory"], r["payload_g"], r["orientation"]))
-        return None if x is None else bool(abs(x / r["measured"] - 1.0) <= RMSE_TOLERANCE)
+        return None if x is None or not math.isfinite(x) else bool(abs(x / r["measured"] - 1.0) <= RMSE_TOLERANCE)
 
     counts = [sum(within(m, r) is True for r in rows) for m in means]
     everywhere = [r for r in rows if all(within(m, r) is False for m in means)]
@@ -704,10 +706,19 @@ def _members_within_text(detail: dict, r: dict) -> str:
     return f"; within on {within} of the ensemble's {len(means)} members (seeds 0-4{span})"
 
 
+def _known_orders(cells: Sequence[calibrate.CellResult]) -> dict[int, str | None]:
+    """Per trajectory of ``cells`` (one member's Chapter 5 cells) the controllers' order, best first; None
+    where a cell's runs give no mean (a failed run): its order is not known."""
+    rows = [{"controller": c.controller, "trajectory": c.trajectory, "twin_mean": c.mean_rmse} for c in cells]
+    known = _order([r for r in rows if math.isfinite(r["twin_mean"])], "twin_mean")
+    return {t: (known.get(t) if all(math.isfinite(r["twin_mean"]) for r in rows if r["trajectory"] == t) else None)
+            for t in sorted({r["trajectory"] for r in rows})}
+
+
 def member_orders(detail: dict, measured: dict[int, str]) -> dict[int, list[int]]:
     """Per trajectory of ``measured`` (its controller order), the ensemble members (their places in
     ``detail["members"]``) whose Chapter 5 runs put the controllers in that order; {} when ``prediction``'s
-    detail has no orders."""
+    detail has no orders. A member whose order is not known (None) is not among them."""
     orders = detail.get("orders")
     if not orders:
         return {}
@@ -717,7 +728,10 @@ def member_orders(detail: dict, measured: dict[int, str]) -> dict[int, list[int]
 def _members_right_text(detail: dict, t: int, right: Sequence[int]) -> str:
     """How many members put trajectory ``t``'s order right, and which (by the parameters they differ in)."""
     members = detail["members"]
+    unknown = sum(order.get(t) is None for order in detail.get("orders") or [])
     text = f"right on {len(right)} of the ensemble's {len(members)} members"
+    if unknown:
+        text += f" ({unknown} without an order: a run failed)"
     if 0 < len(right) < len(members):
         names = _profiled(members)
         text += " (" + "; ".join(_member_text(members[k], names) for k in right) + ")"
@@ -1255,7 +1269,8 @@ def _why(v: Validation) -> list[str]:
                + " So within what the data allow the twin does not settle " + " and ".join(f"T{t}'s" for t in split)
                + " order: it comes out right on some members and wrong on others, and the committed preset's "
                "order there is one of them, not a finding." if split else
-               "Each order is the same on every member: the parameters the data do not pin do not turn it."))
+               "Each order is right on every member or on none: the parameters the data do not pin do not "
+               "turn it."))
     parts = v.sliding_mode
     if parts and parts["trajectories"]:
         ts = sorted(parts["trajectories"])
