@@ -67,6 +67,12 @@ PARAMETER_TEXT = {
 }
 
 
+def rmse_within(twin: float, measured: float) -> bool:
+    """Whether a twin's RMSE mean is within :data:`RMSE_TOLERANCE` of the measured one (False for nan; a
+    numpy bool for numpy numbers)."""
+    return abs(twin / measured - 1) <= RMSE_TOLERANCE
+
+
 def _with_unit(text: str, unit: str) -> str:
     return f"{text} {unit}" if unit else text
 
@@ -159,7 +165,7 @@ def measured_rows(cells: Sequence[calibrate.CellResult]) -> list[dict]:
         target = calibrate.TARGET_OF[cell.key]
         s = spread(cell.rmse_deg)
         rows.append(_row(target.source, cell.controller, cell.trajectory, cell.payload_g, cell.orientation,
-                         "as-built", target.rmse_deg, s.mean, s.std, abs(s.mean / target.rmse_deg - 1) <= RMSE_TOLERANCE))
+                         "as-built", target.rmse_deg, s.mean, s.std, rmse_within(s.mean, target.rmse_deg)))
         if target.sse_range_deg is not None:
             twin = None if math.isnan(cell.sse_range) else cell.sse_range
             sse_rows.append(_row(f"{target.source}, T1 SSE range", cell.controller, 1, cell.payload_g,
@@ -195,7 +201,7 @@ def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.Ce
         means = [float(np.mean(g)) for g in groups if all(math.isfinite(x) for x in g)]
 
         def within(x: float, measured: float = target.rmse_deg) -> bool:
-            return abs(x / measured - 1) <= RMSE_TOLERANCE
+            return rmse_within(x, measured)
 
         mine = five_of.get(cell.key)
         row = {"controller": cell.controller, "trajectory": cell.trajectory, "payload_g": cell.payload_g,
@@ -619,7 +625,7 @@ def payload_phases(committed: dict[str, float]) -> list[dict]:
     move_end = trajectory(1, spur_radius=plant.params.gears.spur_radius).segments[0].duration  # s
     controllers = {key[0] for key in calibrate.CELLS if key[1] == 1 and (key[2] > 0 or key[3] != "horizontal")}
     keys = sorted((key for key in calibrate.CELLS if key[1] == 1 and key[0] in controllers),  # each law's 0 g flat first
-                  key=lambda key: (sorted(controllers).index(key[0]), key[3] != "horizontal", key[2]))
+                  key=lambda key: (key[0], key[3] != "horizontal", key[2]))
     results = run_many([Scenario(c, t, payload=g * 1e-3, orientation=Orientation(o), plant=plant, seed=s)
                         for c, t, g, o in keys for s in SEEDS])
     rows = []
@@ -634,10 +640,11 @@ def payload_phases(committed: dict[str, float]) -> list[dict]:
     return rows
 
 
-def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], progress=None
-               ) -> tuple[list[dict], list[calibrate.CellResult], dict]:
+def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], progress=None,
+               ran: Sequence[calibrate.CellResult] = ()) -> tuple[list[dict], list[calibrate.CellResult], dict]:
     """The T3 cells on each ensemble member and on the ``committed`` values (the runs of the member
-    with those values, which the ensemble lists first, else their own); see the module docstring."""
+    with those values, which the ensemble lists first, else their own); see the module docstring.
+    ``ran``: cells already run on ``committed`` with the evaluator's seeds, not run again for it."""
     from twin.plants.as_built import ensemble_values
 
     members = ensemble_values()
@@ -646,7 +653,10 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     keys = PREDICTION_CELLS + tuple(key for key in calibrate.CELLS if key not in PREDICTION_CELLS)
     per_member, fitted = [], []
     for values in members:
-        found = {cell.key: cell for cell in evaluator.cells(values, keys=keys)}
+        found = {cell.key: cell for cell in ran} if values == committed else {}
+        missing = [key for key in keys if key not in found]
+        if missing:
+            found.update((cell.key, cell) for cell in evaluator.cells(values, keys=missing))
         per_member.append([found[key] for key in PREDICTION_CELLS])
         fitted.append([found[key] for key in calibrate.CELLS])
         if progress:
@@ -678,7 +688,7 @@ def _why_members(v: Validation) -> list[str]:
 
     def within(m: dict, r: dict) -> bool | None:  # None: not run, or no mean (a failed run)
         x = m.get((r["controller"], r["trajectory"], r["payload_g"], r["orientation"]))
-        return None if x is None or not math.isfinite(x) else bool(abs(x / r["measured"] - 1.0) <= RMSE_TOLERANCE)
+        return None if x is None or not math.isfinite(x) else bool(rmse_within(x, r["measured"]))
 
     counts = [sum(within(m, r) is True for r in rows) for m in means]
     everywhere = [r for r in rows if all(within(m, r) is False for m in means)]
@@ -700,8 +710,9 @@ def _members_within_text(detail: dict, r: dict) -> str:
     means = [m[key] for m in detail.get("fitted_means") or [] if key in m]
     if not means:
         return ""
-    ratios = [x / r["measured"] for x in means if math.isfinite(x)]  # a member whose runs failed has none
-    within = sum(abs(x - 1.0) <= RMSE_TOLERANCE for x in ratios)
+    finite = [x for x in means if math.isfinite(x)]  # a member whose runs failed has no mean
+    within = sum(rmse_within(x, r["measured"]) for x in finite)
+    ratios = [x / r["measured"] for x in finite]
     span = f"; x{min(ratios):.2f}-x{max(ratios):.2f}" if ratios else ""
     return f"; within on {within} of the ensemble's {len(means)} members (seeds 0-4{span})"
 
@@ -796,7 +807,7 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
         step()
         phases = payload_phases(committed)
         step()
-        predicted, own, detail = prediction(evaluator, committed, progress=step)
+        predicted, own, detail = prediction(evaluator, committed, progress=step, ran=cells)
     finally:
         evaluator.close()
     failed = sum(c.failed for c in (*cells, *fresh, *own)) + sum(len(run.warnings) > 0 for run in study.runs)

@@ -75,6 +75,7 @@ class CompressibleCircuit:
             supply_pressure=self.source.copy(), line_flow=np.zeros_like(self.source))
         compliance = line.compliance + (line.accumulator_compliance if line.model == "accumulator" else 0.0)
         self._line = None if line.model == "constant" else (compliance, line.inertance, line.resistance)
+        self._every = np.ones(len(self.source), dtype=np.bool_)  # ``live`` when every scenario is
 
     def volumes(self, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Chamber volumes (m^3) at rack position ``y``; never below a tenth of the dead volume."""
@@ -116,7 +117,7 @@ class CompressibleCircuit:
             self.area, fp.viscous, h / ch.substeps, ch.substeps, ch.leak_conductance,
             ch.air_fraction * ch.atmospheric_pressure, 1.0 / ch.water_bulk_modulus, ch.atmospheric_pressure,
             VAPOUR_MARGIN - ch.atmospheric_pressure, self._line is not None, *line,
-            np.ones(len(y), dtype=np.bool_) if live is None else np.asarray(live, dtype=np.bool_), out)
+            self._every if live is None else np.asarray(live, dtype=np.bool_), out)
         return TickForces(cylinder_a=out[0], cylinder_b=out[1], velocity=out[2], stuck=out[3] > 0.5)
 
 

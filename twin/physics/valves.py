@@ -98,6 +98,7 @@ class ValveBank:
         self._off_run = np.full((n, 4), 1 << 30, dtype=np.int64)
         self._open = np.zeros((n, 4), dtype=bool)
         self._conductance = np.zeros((n, 4))
+        self._every = np.ones(n, dtype=np.bool_)  # ``live`` when every scenario is
 
     def reset(self) -> None:
         self._plunger[:] = 0.0
@@ -120,7 +121,7 @@ class ValveBank:
             solenoid.tick_openings(coil, self.substeps, self.tick / self.substeps, s.coil_time_constant_on,
                                    s.coil_time_constant_off, s.force_ratio, s.gap_ratio, s.spring_ratio,
                                    s.natural_frequency, s.damping_ratio, self._plunger, out,
-                                   np.ones(self.n, dtype=np.bool_) if live is None else live)
+                                   self._every if live is None else live)
             return out * self.full_conductance
         _valve_tick(duty, int(tick), self.duty_steps, self.period_ticks, self.model is ValveModel.AVERAGED,
                     float(p.dead_zone_duty), bool(p.supply_held_in_dead_zone),
