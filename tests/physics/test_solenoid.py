@@ -147,3 +147,31 @@ def test_the_solenoid_preset_runs_without_warnings():
 
     result = run(Scenario("smc", 1, plant="thesis-solenoid"))
     assert not result.warnings and math.degrees(result.metrics.rmse) < 10.0
+
+
+def test_the_plant_kernel_equals_stepping_every_sub_step_bit_for_bit():
+    """``tick_openings`` skips the plunger's arithmetic for a valve held on its stop, and every step
+    once the coil current has settled to its last bit; over holds long enough for both (coil on 0.3 s,
+    off 2 s: the off current takes ~1.3 s to reach its smallest value), then pulses, its states and
+    each tick's mean opening must be the bits that :func:`solenoid.simulate` gives step by step."""
+    substeps = int(round(1e-3 / H))
+    coil = [1.0] * 300 + [0.0] * 2000 + ([1.0] * 6 + [0.0] * 10) * 20
+    ticks = np.repeat(np.array(coil), substeps)
+    stepped, _ = solenoid.simulate(P, ticks, h=H)
+    state = np.zeros((1, 1, 3))
+    opening = np.empty((1, 1))
+    live = np.ones(1, dtype=np.bool_)
+    for k, s in enumerate(coil):
+        solenoid.tick_openings(np.array([[s]]), substeps, H, P.coil_time_constant_on, P.coil_time_constant_off,
+                               P.force_ratio, P.gap_ratio, P.spring_ratio, P.natural_frequency, P.damping_ratio,
+                               state, opening, live)
+        lifts = stepped[k * substeps:(k + 1) * substeps, 1]
+        total = 0.0
+        for x in lifts:  # the kernel's order of addition
+            total += x
+        assert opening[0, 0] == total / substeps, k
+        assert tuple(state[0, 0]) == tuple(stepped[(k + 1) * substeps - 1, :3]), k
+    current = stepped[:, 0]
+    for start, end in ((0, 300), (300, 2300)):  # each hold's current settled well before its end: the shortcut ran
+        assert current[(end - 100) * substeps] == current[end * substeps - 1]
+        assert current[start * substeps] != current[end * substeps - 1]

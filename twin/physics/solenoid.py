@@ -153,6 +153,13 @@ def tick_openings(coil, substeps, h, tau_on, tau_off, force_ratio, gap_ratio, sp
                     force = force_ratio * i_next * i_next / (gap * gap) - (1.0 + spring_ratio * x)
                     if (x == 0.0 and force > 0.0) or (x == 1.0 and force < 0.0):
                         break
+                    if i_next == i:
+                        # The current has stopped changing (it has settled to its last bit): every step
+                        # left would repeat this one exactly, so they are added at once. total is k x with
+                        # x 0 or 1, a whole number, so this sum is exact: the same bits as stepping on.
+                        total += x * (substeps - k)
+                        k = substeps
+                        break
                     i = i_next
                     total += x
                     k += 1
