@@ -72,3 +72,19 @@ def test_trial_one_joint_prints_what_as_built_md_quotes(capsys):
             "smc T3 0 g H 2.30 | smc T3 13.5 g V 3.53") in out
     assert ("noise x1.73: ffpva T1 0 g H 1.49 | ffpva T3 0 g H 2.35 | ffpva T3 13.5 g V 3.65 | smc T1 0 g H 1.39 | "
             "smc T3 0 g H 2.38 | smc T3 13.5 g V 3.55") in out
+
+
+@pytest.mark.slow  # about 4 min on 2 cores: seven parameter sets x 21 cells x 40 seeds, and T3 13.5 g vertical
+def test_trial_load_friction_edge_prints_what_prediction_md_quotes(capsys):
+    _load("trial_load_friction_edge").main()
+    rows = {line.split(" | ")[0].split()[0]: line.split(" | ")[1:] for line in capsys.readouterr().out.splitlines()[1:]}
+    assert rows["0.293"] == ["0.559 / 0.757 / 0.741 / 0.895", "+0.000 (+0.000 to +0.000)", "0.675", "0.000",
+                             "3.51 / 3.42"]
+    assert rows["0.000"][1:] == ["+0.237 (+0.205 to +0.302)", "0.888", "0.000", "2.79 / 2.74"]
+    assert rows["0.150"][1:] == ["+0.200 (+0.164 to +0.230)", "0.875", "0.000", "3.11 / 3.05"]
+    assert rows["0.350"] == ["0.560 / 0.748 / 0.783 / 0.865", "+0.001 (-0.030 to +0.041)", "0.690", "0.090",
+                             "3.79 / 3.72"]
+    assert rows["0.400"] == ["0.793 / 0.861 / 0.680 / 0.997", "+0.095 (-0.061 to +0.234)", "0.784", "0.000",
+                             "4.22 / 4.12"]
+    assert rows["0.450"][1:] == ["+0.165 (+0.122 to +0.204)", "0.858", "0.000", "4.74 / 4.53"]
+    assert rows["0.600"][1:] == ["+0.202 (+0.174 to +0.247)", "0.885", "0.000", "7.26 / 6.84"]
