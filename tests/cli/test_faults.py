@@ -430,6 +430,7 @@ def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, 
     (["whatif", "smc-phi", "--out", "OUT", "--seeds", "1001"], "seeds per case must be an integer from 1 to 1000"),
     (["whatif", "observer", "--out", "OUT", "--seeds", "100000"], "seeds per case"),
     (["demo", "--out", "OUT", "--seeds", "100000"], "seeds per case"),
+    (["whatif", "next-experiment", "--out", "OUT", "--prediction-seeds", "1000000"], "seeds per case"),
     # the committed preset and each ensemble member, every cell of Chapter 6, 1000 seeds each
     (["study", "robustness", "--out", "OUT", "--seeds", "1000"],
      f"the grid has {1000 * len(ROBUSTNESS_CELLS) * (1 + len(ensemble_values())):,} scenarios: more than the 100,000"),
@@ -568,7 +569,7 @@ def test_a_folder_made_here_but_locked_by_another_first_is_left_to_it(tmp_path, 
     import contextlib
 
     from twin.batch.lock import FolderBusy
-    from twin.cli import experiments
+    from twin.cli import common
 
     @contextlib.contextmanager
     def taken_first(folder):
@@ -576,8 +577,200 @@ def test_a_folder_made_here_but_locked_by_another_first_is_left_to_it(tmp_path, 
         raise FolderBusy(f"{folder} is being written by process 1")
         yield
 
-    monkeypatch.setattr(experiments, "folder_lock", taken_first)
+    monkeypatch.setattr(common, "folder_lock", taken_first)
     out = tmp_path / "new"
     assert main(["whatif", "gear-load", "--out", str(out)]) == 2
     _one_line_error(capsys, "is being written by process 1")
     assert (out / "theirs.bin").read_bytes() == b"hours"
+
+
+def test_sigterm_stops_an_experiment_as_ctrl_c_does(tmp_path, capsys, monkeypatch):
+    """`kill` (SIGTERM) during a what-if: the same line, exit 130 and clean-up as Ctrl-C (the folder it
+    made is gone), and the handler it replaced is back afterwards."""
+    from twin.experiments.whatifs import gear_load
+
+    def run(self, args, out):
+        (out / "partial.bin").write_bytes(b"x")
+        os.kill(os.getpid(), signal.SIGTERM)
+        time.sleep(5)  # the signal arrives first
+        raise AssertionError("SIGTERM did not stop the run")
+
+    monkeypatch.setattr(type(gear_load.EXPERIMENT), "run", run)
+    before = signal.getsignal(signal.SIGTERM)
+    out = tmp_path / "new"
+    assert main(["whatif", "gear-load", "--out", str(out)]) == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "twin: interrupted"
+    assert not out.exists()
+    assert signal.getsignal(signal.SIGTERM) is before
+
+
+def test_a_figure_that_cannot_be_drawn_costs_no_table(tmp_path, capsys, monkeypatch):
+    """A plotting library's error (not the disk's) leaves the tables written: exit 1, one line naming the
+    figure, and no figure of an earlier run left to pass for this one's."""
+    from twin.experiments.whatifs import gear_load
+
+    def broken(self, outcome, path):
+        path.write_bytes(b"half a png")
+        raise ValueError("no such font\nsecond line")
+
+    out = tmp_path / "g"
+    out.mkdir()
+    (out / "gear-load.png").write_bytes(b"an earlier run's")
+    monkeypatch.setattr(type(gear_load.EXPERIMENT), "plot", broken)
+    assert main(["whatif", "gear-load", "--out", str(out)]) == 1
+    err = capsys.readouterr().err
+    assert "twin: could not draw gear-load.png: ValueError: no such font\n" in err and "Traceback" not in err
+    assert sorted(p.name for p in out.iterdir()) == [".twin.lock", "gear-load.csv", "gear-load.txt"]
+
+
+def _calibration_stand_ins(monkeypatch, preset):
+    """``twin calibrate`` with its fit, record and plot stood in for (the file handling is under test)."""
+    from twin.experiments import calibrate
+    from twin.plants import as_built
+
+    monkeypatch.setattr(as_built, "CALIBRATION_FILE", preset)
+    monkeypatch.setattr(calibrate, "calibrate", lambda **kwargs: type("R", (), {"evaluations": 1, "wall_time": 0.0}))
+    monkeypatch.setattr(calibrate, "record", lambda result: {"fitted": {"stiction": 1.0}})
+    monkeypatch.setattr(calibrate, "format_residuals", lambda data: "residuals")
+
+
+def test_calibrate_install_is_checked_before_the_fit(tmp_path, capsys, monkeypatch):
+    from twin.experiments import calibrate
+
+    _calibration_stand_ins(monkeypatch, pathlib.Path("/proc/as_built.json"))
+    monkeypatch.setattr(calibrate, "calibrate", lambda **kwargs: pytest.fail("the fit ran"))
+    assert main(["calibrate", "--out", str(tmp_path / "c"), "--install"]) == 2
+    _one_line_error(capsys, "--install: cannot write the as-built preset's folder /proc")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_calibrate_installs_whole_or_not_at_all_and_before_its_figure(tmp_path, capsys, monkeypatch):
+    """The preset is replaced by a rename: a disk that fills while the new one is written leaves the old
+    one whole (and no temporary); the figure comes after the install, and its failure loses neither file."""
+    import json
+
+    import viz.calibration_plots
+
+    preset = tmp_path / "data" / "as_built.json"
+    preset.parent.mkdir()
+    preset.write_text('{"old": true}\n')
+    _calibration_stand_ins(monkeypatch, preset)
+    real = pathlib.Path.write_text
+
+    def full_disk(self, text, *args, **kwargs):
+        if self.parent == preset.parent:
+            real(self, text[:5], *args, **kwargs)
+            raise OSError(errno.ENOSPC, "No space left on device", str(self))
+        return real(self, text, *args, **kwargs)
+
+    monkeypatch.setattr(pathlib.Path, "write_text", full_disk)
+    assert main(["calibrate", "--out", str(tmp_path / "c1"), "--install"]) == 2
+    _one_line_error(capsys, "No space left on device")
+    assert preset.read_text() == '{"old": true}\n' and sorted(p.name for p in preset.parent.iterdir()) == [
+        "as_built.json"]
+    assert not (tmp_path / "c1").exists()  # the folder it made goes with the failed run
+    monkeypatch.setattr(pathlib.Path, "write_text", real)
+
+    def broken(data, path):
+        raise RuntimeError("matplotlib says no")
+
+    monkeypatch.setattr(viz.calibration_plots, "plot_calibration", broken)
+    assert main(["calibrate", "--out", str(tmp_path / "c2"), "--install"]) == 1
+    err = capsys.readouterr().err
+    assert "twin: could not draw calibration.png: RuntimeError: matplotlib says no" in err
+    assert json.loads(preset.read_text()) == {"fitted": {"stiction": 1.0}}
+    assert (tmp_path / "c2" / "as_built.json").read_text() == preset.read_text()
+
+
+@pytest.mark.slow  # about 10 s on 2 cores: four demos of 12-36 runs
+def test_a_demo_rerun_leaves_one_run_in_its_folder_and_a_stopped_one_leaves_it_as_it_was(tmp_path, capsys,
+                                                                                      monkeypatch):
+    """Fewer seeds, then a demo stopped while it plots: the folder holds the last whole run's files only
+    (no figure of a run with more seeds, no staging folder), and the user's own files stay."""
+    import viz.plots
+
+    drawn = []
+
+    def quick(result, path):  # the file handling is under test, not the figure
+        drawn.append(path.name)
+        path.write_bytes(b"png")
+
+    monkeypatch.setattr(viz.plots, "plot_run", quick)
+    out = tmp_path / "demo"
+    assert main(["demo", "--out", str(out), "--seeds", "2"]) == 0
+    (out / "mine.txt").write_text("keep")
+    assert main(["demo", "--out", str(out), "--seeds", "1"]) == 0
+    names = sorted(p.name for p in out.iterdir())
+    assert names == sorted([".twin.lock", "mine.txt", "results.csv", "summary.md",
+                            *[f"{c}_T{t}_seed0.png" for c in ("pva", "ffpva", "smc") for t in (1, 2, 3, 4)]])
+    table = (out / "results.csv").read_text()
+
+    def stopped(result, path):
+        if len(drawn) > 3:
+            raise KeyboardInterrupt
+        quick(result, path)
+
+    drawn.clear()
+    monkeypatch.setattr(viz.plots, "plot_run", stopped)
+    assert main(["demo", "--out", str(out), "--seeds", "3"]) == 130
+    assert sorted(p.name for p in out.iterdir()) == names and (out / "results.csv").read_text() == table
+    drawn.clear()
+    assert main(["demo", "--out", str(tmp_path / "new"), "--seeds", "1"]) == 130
+    assert not (tmp_path / "new").exists()
+
+
+def test_a_sweep_on_ray_without_ray_is_one_line_before_anything(tmp_path, capsys, monkeypatch):
+    import importlib.util
+
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "ray" else real(name, *a))
+    assert main(["sweep", "--seed", "0", "--backend", "ray", "--out", str(tmp_path / "s")]) == 2
+    _one_line_error(capsys, "--backend ray: Ray is not installed here")
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.slow  # over ~2.5 s on 2 cores: two sweeps
+def test_a_sweep_whose_plot_fails_writes_its_tables(tmp_path, capsys, monkeypatch):
+    import viz.sweep_plots
+
+    out = tmp_path / "s"
+    argv = ["sweep", "--controller", "ffpva", "--trajectory", "2", "--seed", "0", "--workers", "1", "--out", str(out)]
+    assert main(argv) == 0
+    assert (out / "rmse.png").exists()
+    monkeypatch.setattr(viz.sweep_plots, "plot_summary", lambda summary, path: 1 / 0)
+    assert main(argv) == 1
+    err = capsys.readouterr().err
+    assert "twin: could not draw rmse.png: ZeroDivisionError" in err and "Traceback" not in err
+    assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == [
+        "results.csv", "results.parquet", "results.sqlite", "summary.csv"]
+
+
+def test_the_evaluators_workers_leave_ctrl_c_to_the_parent_and_stop_at_once_on_abort():
+    """Like a sweep's: a worker ignores SIGINT (the parent stops it) and dies with its parent; on Ctrl-C,
+    SIGTERM or an error the parent kills them rather than waiting for the share each is running."""
+    from twin.experiments.calibrate import Evaluator
+
+    evaluator = Evaluator(seeds=(0,), workers=2)
+    try:
+        assert evaluator.pool.submit(signal.getsignal, signal.SIGINT).result(timeout=60) == signal.SIG_IGN
+        busy = evaluator.pool.submit(time.sleep, 60)
+        time.sleep(0.5)
+        workers = list(evaluator.pool._processes)  # PIDs
+        started = time.monotonic()
+        evaluator.abort()
+
+        def running(pid: int) -> bool:  # by /proc: the pool's own thread may have reaped it already
+            try:
+                return pathlib.Path(f"/proc/{pid}/stat").read_text().split()[2] != "Z"
+            except OSError:  # gone, or going while read
+                return False
+
+        def alive() -> list[int]:
+            return [pid for pid in workers if running(pid)]
+
+        while alive() and time.monotonic() - started < 10:
+            time.sleep(0.05)
+        assert alive() == [], "workers outlived the abort"
+        busy.exception(timeout=10)  # settled: broken or cancelled, not still running its minute
+    finally:
+        evaluator.abort()

@@ -4,33 +4,45 @@ from __future__ import annotations
 
 import argparse
 import os
+import pathlib
 import sys
 
+from twin.cli.common import output_folder
+from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
+from twin.experiments.base import drawn
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
+    """Exit 0; 1 when the fit's figure could not be drawn (its file is written, and installed if asked)."""
     from twin.experiments import calibrate
     from twin.plants.as_built import CALIBRATION_FILE
     from viz.calibration_plots import plot_calibration
 
-    args.out.mkdir(exist_ok=True)
+    preset = pathlib.Path(str(CALIBRATION_FILE))
+    if args.install and not arguments.can_create_in(preset.parent):  # found out now, not after the fit
+        raise InvalidScenario(f"--install: cannot write the as-built preset's folder {preset.parent}")
 
     def progress(done: int, total: int, stage: str, cost: float, values: dict) -> None:
         shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
         print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
 
-    result = calibrate.calibrate(workers=args.workers, progress=progress)
-    data = calibrate.record(result)
-    path = calibrate.write(data, args.out)
-    plot_calibration(data, args.out / "calibration.png")
+    with output_folder(args.out):
+        result = calibrate.calibrate(workers=args.workers, progress=progress)
+        data = calibrate.record(result)
+        path = calibrate.write(data, args.out)
+        if args.install:
+            calibrate.write(data, preset.parent, name=preset.name)  # whole or not at all (a rename)
+        failures: list[tuple[str, str]] = []
+        figures = drawn(lambda png: plot_calibration(data, png), args.out / "calibration.png", failures)
     print(calibrate.format_residuals(data))
-    print(f"wrote {path} and {args.out / 'calibration.png'} ({result.evaluations} evaluations, "
+    print(f"wrote {', '.join(str(p) for p in [path, *figures])} ({result.evaluations} evaluations, "
           f"{result.wall_time:.0f} s)")
     if args.install:
-        CALIBRATION_FILE.write_text(path.read_text())
-        print(f"installed as the as-built preset: {CALIBRATION_FILE}")
-    return 0
+        print(f"installed as the as-built preset: {preset}")
+    for name, reason in failures:
+        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
+    return 1 if failures else 0
 
 
 def add_parser(sub) -> None:

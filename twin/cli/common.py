@@ -6,8 +6,12 @@ import argparse
 import contextlib
 import os
 import pathlib
+import shutil
+import signal
 import sys
+import threading
 
+from twin.batch.lock import folder_lock
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 from twin.physics.model import Orientation
@@ -132,6 +136,46 @@ def scenario_from(args: argparse.Namespace) -> Scenario:
         orientation=Orientation(args.orientation), plant=plant_of(args), seed=args.seed, noise=args.noise,
         supply_pressure=None if args.supply_kpa is None else args.supply_kpa * 1e3,
     )
+
+
+@contextlib.contextmanager
+def sigterm_as_interrupt():
+    """SIGTERM (``kill``, a job scheduler) stops the ``with`` block as Ctrl-C does, so the same clean-up
+    runs; the previous handler afterwards. Only the main thread may set handlers: elsewhere a no-op."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+@contextlib.contextmanager
+def output_folder(out: pathlib.Path, *, keep_on_failure: bool = False):
+    """A command's ``--out`` for the ``with`` block: made if it does not exist (atomically, so two
+    commands cannot both think they made it), its lock held (one writer; taking it also finds out, before
+    any work, that no file can be made there), SIGTERM taken as Ctrl-C. If the block fails or is
+    stopped, a folder made here is removed again while the lock is still held, unless
+    ``keep_on_failure`` (a store of finished runs). Yields whether the folder was made here."""
+    try:
+        out.mkdir()
+        made = True
+    except FileExistsError:
+        made = False
+    try:
+        with sigterm_as_interrupt(), folder_lock(out):
+            try:
+                yield made
+            except BaseException:
+                if made and not keep_on_failure:
+                    shutil.rmtree(out, ignore_errors=True)
+                raise
+    except OSError:
+        if made and not keep_on_failure:
+            shutil.rmtree(out, ignore_errors=True)  # the lock could not be taken: nothing was written
+        raise
 
 
 @contextlib.contextmanager

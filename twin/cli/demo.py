@@ -5,13 +5,15 @@ from __future__ import annotations
 import argparse
 import pathlib
 
+from twin.cli.common import output_folder
 from twin.experiments import arguments
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
     from twin.experiments.demo import run_demo
 
-    return run_demo(out=args.out, seeds=args.seeds, plots=args.plots)
+    with output_folder(args.out):  # one writer; a folder made here goes again if the demo is stopped
+        return run_demo(out=args.out, seeds=args.seeds, plots=args.plots)
 
 
 def add_parser(sub) -> None:

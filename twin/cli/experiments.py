@@ -4,11 +4,9 @@
 from __future__ import annotations
 
 import argparse
-import shutil
 import sys
 
-from twin.batch.lock import folder_lock
-from twin.cli.common import EXIT_INTERRUPTED, Parser
+from twin.cli.common import EXIT_INTERRUPTED, Parser, output_folder
 from twin.experiments import arguments
 from twin.experiments.base import Experiment
 from twin.experiments.studies import STUDIES
@@ -16,33 +14,26 @@ from twin.experiments.whatifs import WHATIFS
 
 
 def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
-    """Exit 0, or 1 when some run failed, or 130 when interrupted (a resumable one keeps its runs). A folder
-    this command made is removed again, while it still holds the folder's lock, when it stops without its
-    results, unless the experiment is resumable (its store may hold finished runs, whatever stopped it)."""
+    """Exit 0, or 1 when some run failed or a figure could not be drawn (its tables are written), or 130
+    when interrupted (SIGTERM too; a resumable one keeps its runs). A folder this command made is removed
+    again, while it still holds the folder's lock, when it stops without its results, unless the
+    experiment is resumable (its store may hold finished runs, whatever stopped it)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
-    try:
-        args.out.mkdir()  # made here, atomically: two commands on one new folder cannot both think so
-        made = True
-    except FileExistsError:
-        made = False
-    with folder_lock(args.out):  # one writer per folder (a second one stops here, removing nothing)
+    with output_folder(args.out, keep_on_failure=experiment.resumable):
         try:
-            try:
-                outcome = experiment.run(args, args.out)
-            except KeyboardInterrupt:
-                if not experiment.resumable:
-                    raise
-                print(f"interrupted: finished runs are kept in {experiment.store(args.out)}; "
-                      "run the same command again to finish the rest", file=sys.stderr)
-                return EXIT_INTERRUPTED
-            paths = experiment.publish(outcome, args.out)  # all of them or none
-        except BaseException:
-            if made and not experiment.resumable:
-                shutil.rmtree(args.out, ignore_errors=True)
-            raise
+            outcome = experiment.run(args, args.out)
+        except KeyboardInterrupt:
+            if not experiment.resumable:
+                raise
+            print(f"interrupted: finished runs are kept in {experiment.store(args.out)}; "
+                  "run the same command again to finish the rest", file=sys.stderr)
+            return EXIT_INTERRUPTED
+        paths, undrawn = experiment.publish(outcome, args.out)  # every table, or none
     print(outcome.answer)
     print(f"wrote {', '.join(str(p) for p in paths)}")
-    return 1 if outcome.failed else 0
+    for name, reason in undrawn:
+        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
+    return 1 if outcome.failed or undrawn else 0
 
 
 def _group(sub, command: str, help_text: str, experiments: dict[str, Experiment]) -> None:

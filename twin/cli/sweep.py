@@ -3,14 +3,17 @@
 from __future__ import annotations
 
 import argparse
+import importlib.util
+import os
 import pathlib
-import signal
+import shutil
 import sys
+import tempfile
 
-from twin.batch.lock import folder_lock
-from twin.cli.common import EXIT_INTERRUPTED
+from twin.cli.common import EXIT_INTERRUPTED, output_folder
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
+from twin.experiments.base import drawn
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
@@ -28,13 +31,13 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         # with Ray, --workers counts the cluster's CPUs, which this machine's cores do not bound
         raise InvalidScenario(f"--workers: at most {arguments.MAX_WORKERS} local processes (four per core), got "
                               f"{args.workers}")
-    args.out.mkdir(exist_ok=True)
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)  # SIGTERM stops it as Ctrl-C does
-    try:
-        with folder_lock(args.out):  # one writer per folder: a second sweep into it is refused, naming this one
-            return _sweep(args, points)
-    finally:
-        signal.signal(signal.SIGTERM, previous)
+    if args.backend == "ray" and importlib.util.find_spec("ray") is None:
+        raise InvalidScenario("--backend ray: Ray is not installed here (pip install 'ray[default]'), "
+                              "or use --backend local")
+    # one writer per folder (a second sweep into it is refused, naming this one); SIGTERM stops it as Ctrl-C
+    # does; the folder stays whatever stops the sweep: its store keeps the finished scenarios
+    with output_folder(args.out, keep_on_failure=True):
+        return _sweep(args, points)
 
 
 def _sweep(args: argparse.Namespace, points: list) -> int:
@@ -57,19 +60,33 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
         return EXIT_INTERRUPTED
     finally:
         bar.close()
-    tables.write_results(outcome.records, args.out)
-    summary = tables.summarise(outcome.records)
-    tables.write_summary(summary, args.out)
     from viz.sweep_plots import plot_summary
 
-    plot_summary(summary, args.out / "rmse.png")
+    summary = tables.summarise(outcome.records)
+    # The tables and the plot are written beside the folder's files, then renamed into place together:
+    # a stop or a full disk leaves the earlier sweep's set whole (the store keeps every finished scenario).
+    staging = pathlib.Path(tempfile.mkdtemp(prefix=".sweep-", dir=args.out))
+    undrawn: list[tuple[str, str]] = []
+    try:
+        tables.write_results(outcome.records, staging)
+        tables.write_summary(summary, staging)
+        names = ["results.csv", "results.parquet", "summary.csv"]
+        names += [p.name for p in drawn(lambda path: plot_summary(summary, path), staging / "rmse.png", undrawn)]
+        for name in names:
+            os.replace(staging / name, args.out / name)
+        for name, _ in undrawn:  # an earlier sweep's plot must not pass for this one's
+            (args.out / name).unlink(missing_ok=True)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
     print(tables.format_summary(summary))
     failed = [r for r in outcome.records if r["status"] != "ok"]
     for r in failed[:20]:
         print(f"failed: {r['key']}: {r['reason']}", file=sys.stderr)
+    for name, reason in undrawn:
+        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
     print(f"{outcome.ran} run, {outcome.skipped} already done, {len(failed)} failed; "
-          f"wrote results.csv, results.parquet, summary.csv, rmse.png in {args.out}")
-    return 1 if failed else 0
+          f"wrote {', '.join(names)} in {args.out}")
+    return 1 if failed or undrawn else 0
 
 
 def add_parser(sub) -> None:

@@ -28,14 +28,14 @@ def writable_file(suffix: str):
         if path.is_dir():
             raise argparse.ArgumentTypeError(f"{text!r} is a folder, not a file")
         if not os.access(path.parent, os.W_OK) or (path.exists() and not os.access(path, os.W_OK)) \
-                or not _can_create_in(path.parent):
+                or not can_create_in(path.parent):
             raise argparse.ArgumentTypeError(f"cannot write {text!r}")
         return path
 
     return check
 
 
-def _can_create_in(folder: pathlib.Path) -> bool:
+def can_create_in(folder: pathlib.Path) -> bool:
     """Whether a file can be made in ``folder``, tried rather than asked: ``os.access`` says yes to root
     for folders no one can write to (``/proc``), and an output is written only after the work."""
     try:

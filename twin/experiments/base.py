@@ -25,6 +25,7 @@ import os
 import pathlib
 import shutil
 import tempfile
+from collections.abc import Callable
 from typing import Any, ClassVar
 
 from twin.batch.tables import write_csv
@@ -67,12 +68,12 @@ class Experiment:
     def plot(self, outcome: Outcome, path: pathlib.Path) -> None:
         raise NotImplementedError
 
-    def outputs(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
-        """Write the files and the plot; the paths written, the plot last."""
+    def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
+        """Write the files and the plot (:func:`drawn`: a plot that fails goes into ``undrawn``); the paths
+        written, the plot last."""
         paths = self.write(outcome, out)
         png = out / f"{self.name}.png"
-        self.plot(outcome, png)
-        return paths + [png]
+        return paths + drawn(lambda path: self.plot(outcome, path), png, undrawn)
 
     def store(self, out: pathlib.Path) -> pathlib.Path:
         """Where a :attr:`resumable` experiment keeps its finished runs in ``out``."""
@@ -82,17 +83,38 @@ class Experiment:
         """What :meth:`run` itself keeps in ``out`` to list among the files written (a resumable store)."""
         return []
 
-    def publish(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
+    def publish(self, outcome: Outcome, out: pathlib.Path) -> tuple[list[pathlib.Path], list[tuple[str, str]]]:
         """:meth:`outputs` all or nothing: written into a staging folder inside ``out``, then each file
         renamed into ``out`` (renames need no space); if any write fails (a full disk, an interrupt), the
-        staging folder goes and ``out`` keeps what it had. The final paths, in :meth:`outputs`'s order,
-        then :meth:`kept`."""
+        staging folder goes and ``out`` keeps what it had. A figure whose drawing fails otherwise (a
+        plotting library's error) is left out instead, so the tables are not lost with it. Returns the
+        final paths, in :meth:`outputs`'s order, then :meth:`kept`; and the figures left out, as
+        (file name, reason)."""
         staging = pathlib.Path(tempfile.mkdtemp(prefix=f".{self.name}-", dir=out))
+        undrawn: list[tuple[str, str]] = []
         try:
-            staged = self.outputs(outcome, staging)
+            staged = self.outputs(outcome, staging, undrawn)
             final = [out / path.relative_to(staging) for path in staged]
             for path, target in zip(staged, final, strict=True):
                 os.replace(path, target)
-            return final + self.kept(out)
+            for name, _ in undrawn:  # an earlier run's figure must not pass for this run's
+                (out / name).unlink(missing_ok=True)
+            return final + self.kept(out), undrawn
         finally:
             shutil.rmtree(staging, ignore_errors=True)
+
+
+def drawn(draw: Callable[[pathlib.Path], None], path: pathlib.Path,
+          undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
+    """``draw(path)``: the figure at ``path``, best effort: ``[path]``, or ``[]`` with (its name, the reason)
+    added to ``undrawn`` when the drawing fails. A failing disk (OSError) and a stop (KeyboardInterrupt,
+    which is no Exception) still stop the whole publication."""
+    try:
+        draw(path)
+    except OSError:
+        raise
+    except Exception as error:  # noqa: BLE001 - a plotting library's error of any kind must not cost the tables
+        path.unlink(missing_ok=True)
+        undrawn.append((path.name, f"{type(error).__name__}: {error}".splitlines()[0]))
+        return []
+    return [path]

@@ -47,13 +47,14 @@ import dataclasses
 import json
 import math
 import multiprocessing
+import os
 import pathlib
 import time
 from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from twin.batch.sweep import code_version
+from twin.batch.sweep import code_version, worker_setup
 from twin.experiments.reference import (
     THESIS_EXPERIMENT_RMSE_DEG,
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
@@ -185,12 +186,24 @@ class Evaluator:
 
     def __init__(self, *, seeds: Sequence[int], workers: int, cells: Sequence[tuple] = CELLS):
         self.seeds, self.workers, self.keys = tuple(seeds), workers, tuple(cells)
-        self.pool = (concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"))
+        # worker_setup: Ctrl-C is the parent's to handle, and a worker dies with its parent
+        self.pool = (concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
+                                                            initializer=worker_setup)
                      if workers > 1 else None)
 
     def close(self) -> None:
+        """Let the workers finish and go (the work is done)."""
         if self.pool is not None:
             self.pool.shutdown()
+
+    def abort(self) -> None:
+        """Stop the workers now, without waiting for the share each may be running (on Ctrl-C, SIGTERM or
+        an error: nobody will read it)."""
+        if self.pool is not None:
+            processes = list((getattr(self.pool, "_processes", None) or {}).values())
+            self.pool.shutdown(wait=False, cancel_futures=True)
+            for process in processes:
+                process.kill()
 
     def cells(self, values: dict[str, float], *, without: Sequence[str] = (), seeds: Sequence[int] | None = None,
               keys: Sequence[tuple] | None = None) -> list[CellResult]:
@@ -398,8 +411,10 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
         best, fit_cells = seen[lowest()]
         check_cells = _cells_of(fit_cells, check_seeds) or (evaluator.cells(best.values, seeds=check_seeds)
                                                             if check_seeds else [])
-    finally:
-        evaluator.close()
+    except BaseException:
+        evaluator.abort()
+        raise
+    evaluator.close()
     return Calibration(values=best.values, cost=best.cost, evaluations=len(history), history=history,
                        fit_cells=fit_cells, check_cells=check_cells, noise_costs=noise_costs,
                        ensemble=choose_ensemble(history, best, cost_noise(noise_costs)),
@@ -453,11 +468,16 @@ def record(result: Calibration) -> dict:
     }
 
 
-def write(data: dict, out: pathlib.Path) -> pathlib.Path:
-    path = out / "as_built.json"
-    tmp = path.with_suffix(".json.tmp")
-    tmp.write_text(json.dumps(data, indent=1) + "\n")
-    tmp.replace(path)
+def write(data: dict, out: pathlib.Path, name: str = "as_built.json") -> pathlib.Path:
+    """``data`` as ``out/name``, whole or not at all: written beside it, then renamed over it (an
+    earlier file stays as it was if the write fails)."""
+    path = out / name
+    tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
+    try:
+        tmp.write_text(json.dumps(data, indent=1) + "\n")
+        tmp.replace(path)
+    finally:
+        tmp.unlink(missing_ok=True)
     return path
 
 

@@ -4,19 +4,27 @@ Runs PVA + DZC, FF + PVA and sliding mode on T1 - T4 on the ``thesis`` plant,
 over several noise seeds, in one batch; prints RMSE, SSE and max error (mean
 and std over seeds) beside the thesis's simulated values (SPEC §8), and writes
 into the output folder: ``results.csv`` (one row per run), ``summary.md`` (the
-table) and one PNG per run.
+table) and one PNG per run. They are written beside the folder's files first and
+renamed into place together once all are written (so a stop or a full disk leaves
+the folder as it was), and the PNGs of an earlier demo run in that folder that this
+run did not draw (fewer seeds, ``--no-plots``) are removed: the folder shows one run.
 """
 
 from __future__ import annotations
 
 import csv
+import os
 import pathlib
+import re
+import shutil
 import sys
+import tempfile
 
 import numpy as np
 from tqdm import tqdm
 
 from twin.envs.runner import run_many
+from twin.experiments.base import drawn
 from twin.experiments.reference import (
     THESIS_SIMULATED_RMSE_DEG,
     THESIS_SIMULATED_SSE_T1_DEG,
@@ -91,6 +99,9 @@ def markdown_table(rows: list[dict]) -> str:
     return "\n".join(lines)
 
 
+RUN_FIGURE = re.compile(rf"({'|'.join(CONTROLLER_NAMES)})_T[1-4]_seed\d+\.png")  # the name of a run's PNG
+
+
 def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
     out.mkdir(parents=True, exist_ok=True)
     scenarios = demo_scenarios(seeds)
@@ -103,29 +114,44 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
 
         results = run_many(scenarios, progress=progress)
 
-    with open(out / "results.csv", "w", newline="") as handle:
-        writer = None
-        for result in results:
-            record = report.summary(result)
-            record["warnings"] = ";".join(record["warnings"])
-            record["rest_errors_deg"] = ";".join(f"{e:.4f}" for e in record["rest_errors_deg"])
-            if writer is None:
-                writer = csv.DictWriter(handle, fieldnames=list(record))
-                writer.writeheader()
-            writer.writerow(record)
     rows = summary_rows(results)
     table = markdown_table(rows) + "\n\n" + rest_error_table(results)
-    (out / "summary.md").write_text(
-        f"# Thesis controller comparison on the twin ('thesis' plant, {seeds} seeds)\n\n{table}\n")
-    if plots:
-        from viz.plots import plot_run
+    staging = pathlib.Path(tempfile.mkdtemp(prefix=".demo-", dir=out))
+    try:
+        with open(staging / "results.csv", "w", newline="") as handle:
+            writer = None
+            for result in results:
+                record = report.summary(result)
+                record["warnings"] = ";".join(record["warnings"])
+                record["rest_errors_deg"] = ";".join(f"{e:.4f}" for e in record["rest_errors_deg"])
+                if writer is None:
+                    writer = csv.DictWriter(handle, fieldnames=list(record))
+                    writer.writeheader()
+                writer.writerow(record)
+        (staging / "summary.md").write_text(
+            f"# Thesis controller comparison on the twin ('thesis' plant, {seeds} seeds)\n\n{table}\n")
+        names = ["results.csv", "summary.md"]
+        undrawn: list[tuple[str, str]] = []
+        if plots:
+            from viz.plots import plot_run
 
-        for result in tqdm(results, desc="plotting", unit="png", file=sys.stderr, dynamic_ncols=True):
-            s = result.scenario
-            plot_run(result, out / f"{s.controller}_T{s.trajectory}_seed{s.seed}.png")
+            for result in tqdm(results, desc="plotting", unit="png", file=sys.stderr, dynamic_ncols=True):
+                s = result.scenario
+                png = staging / f"{s.controller}_T{s.trajectory}_seed{s.seed}.png"
+                names += [path.name for path in drawn(lambda path, r=result: plot_run(r, path), png, undrawn)]
+        for name in names:
+            os.replace(staging / name, out / name)
+    finally:
+        shutil.rmtree(staging, ignore_errors=True)
+    for stale in out.iterdir():  # an earlier run's figures that this run did not draw
+        if RUN_FIGURE.fullmatch(stale.name) and stale.name not in names:
+            stale.unlink(missing_ok=True)
     print(table)
     failed = [r for r in results if r.warnings]
     for r in failed:
         print(f"warning: {r.scenario}: {', '.join(r.warnings)}", file=sys.stderr)
-    print(f"\nWrote {out / 'results.csv'}, {out / 'summary.md'}" + (f" and {len(results)} PNGs" if plots else ""))
-    return 1 if failed else 0
+    for name, reason in undrawn:
+        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
+    print(f"\nWrote {out / 'results.csv'}, {out / 'summary.md'}"
+          + (f" and {len(names) - 2} PNGs" if plots else ""))
+    return 1 if failed or undrawn else 0

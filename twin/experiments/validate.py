@@ -38,7 +38,7 @@ import numpy as np
 
 from twin.batch.tables import write_csv
 from twin.experiments import calibrate
-from twin.experiments.base import Experiment, Outcome
+from twin.experiments.base import Experiment, Outcome, drawn
 from twin.experiments.reference import (
     ROBUSTNESS_CELLS,
     THESIS_EXPERIMENT_MAX_ERROR_DEG,
@@ -808,8 +808,10 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
         phases = payload_phases(committed)
         step()
         predicted, own, detail = prediction(evaluator, committed, progress=step, ran=cells)
-    finally:
-        evaluator.close()
+    except BaseException:
+        evaluator.abort()
+        raise
+    evaluator.close()
     failed = sum(c.failed for c in (*cells, *fresh, *own)) + sum(len(run.warnings) > 0 for run in study.runs)
     failed += sum(run["warnings"] > 0 for r in full_duty for run in r["runs"].values())
     failed += sum(r["failed_runs"] for r in phases)
@@ -1748,25 +1750,27 @@ class ValidateExperiment(Experiment):
                   + f"; {stalled} stalled runs.")
         return Outcome(rows=v.rows, answer=answer, failed=v.failed, detail=v)
 
-    def outputs(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
+    def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
         """``validation.csv``, ``prediction.csv``, ``validation.md`` and its figures, ``seeds.csv``
         (:func:`seed_rows`), ``effects.csv`` (:func:`payload_effects`) and ``misses.csv`` (:func:`misses`)
-        (the CLI's :meth:`publish` makes them all or nothing)."""
+        (the CLI's :meth:`publish` makes them all or nothing; a figure that cannot be drawn is left out and
+        named in ``undrawn``)."""
         v = outcome.detail
-        paths = [out / "validation.csv", out / "prediction.csv", out / "validation.md", out / "validation.png",
-                 out / "prediction.png", out / "pulses.png", out / "seeds.csv", out / "seeds.png", out / "effects.csv",
-                 out / "effects.png", out / "misses.csv"]
+        paths = [out / "validation.csv", out / "prediction.csv", out / "validation.md"]
         write_csv(v.rows, VALIDATION_COLUMNS, paths[0])
         write_csv(v.prediction, PREDICTION_COLUMNS, paths[1])
         paths[2].write_text(report(v))
-        figure_validation(v.rows, paths[3])
-        figure_prediction(v, paths[4])
-        figure_pulses(v, paths[5])
-        write_csv(v.seeds or [], SEED_COLUMNS, paths[6])
-        figure_seeds(v, paths[7])
-        write_csv(v.effects, EFFECT_COLUMNS, paths[8])
-        figure_effects(v, paths[9])
-        write_csv(misses(v), MISS_COLUMNS, paths[10])
+        paths += drawn(lambda path: figure_validation(v.rows, path), out / "validation.png", undrawn)
+        paths += drawn(lambda path: figure_prediction(v, path), out / "prediction.png", undrawn)
+        paths += drawn(lambda path: figure_pulses(v, path), out / "pulses.png", undrawn)
+        paths.append(out / "seeds.csv")
+        write_csv(v.seeds or [], SEED_COLUMNS, paths[-1])
+        paths += drawn(lambda path: figure_seeds(v, path), out / "seeds.png", undrawn)
+        paths.append(out / "effects.csv")
+        write_csv(v.effects, EFFECT_COLUMNS, paths[-1])
+        paths += drawn(lambda path: figure_effects(v, path), out / "effects.png", undrawn)
+        paths.append(out / "misses.csv")
+        write_csv(misses(v), MISS_COLUMNS, paths[-1])
         return paths
 
 

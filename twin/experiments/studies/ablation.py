@@ -59,8 +59,10 @@ def ablation_study(*, seeds: Sequence[int] = CHECK_SEEDS, workers: int = 2,
                 rows.append({"variant": label, **row, "within_tolerance": within})
             if progress is not None:
                 progress(done, len(variants()), label)
-    finally:
-        evaluator.close()
+    except BaseException:
+        evaluator.abort()
+        raise
+    evaluator.close()
     return Ablation(rows=rows, seeds=tuple(seeds))
 
 

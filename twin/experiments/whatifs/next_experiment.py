@@ -49,6 +49,7 @@ import numpy as np
 
 import twin.experiments.whatifs.ensemble as ensemble
 from twin.exceptions import InvalidScenario
+from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import ROBUSTNESS_CELLS
 from twin.experiments.whatifs.common import progress_bar
@@ -304,7 +305,7 @@ class NextExperimentWhatIf(Experiment):
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
         ensemble.add_ensemble_arguments(parser, seeds=4)
-        parser.add_argument("--prediction-seeds", type=int, default=3, metavar="N",
+        parser.add_argument("--prediction-seeds", type=arguments.seed_count, default=3, metavar="N",
                             help="seeds per Chapter 6 cell and member for the predictions (default 3)")
         parser.add_argument("--pressure-step", type=float, default=10.0, metavar="KPA",
                             help="supply pressure step of the breakaway map, kPa (default 10)")
@@ -315,8 +316,6 @@ class NextExperimentWhatIf(Experiment):
             raise InvalidScenario("--members: the refit needs at least 2 ensemble members")
         if args.seeds < 2:
             raise InvalidScenario("--seeds: the spread within a member needs at least 2 seeds")
-        if args.prediction_seeds < 1:
-            raise InvalidScenario("--prediction-seeds: at least 1")
         if not (math.isfinite(args.pressure_step) and 1.0 <= args.pressure_step <= 100.0):
             raise InvalidScenario(f"--pressure-step: 1-100 kPa, got {args.pressure_step:g}")
 
