@@ -675,9 +675,15 @@ def test_calibrate_installs_whole_or_not_at_all_and_before_its_figure(tmp_path, 
         raise RuntimeError("matplotlib says no")
 
     monkeypatch.setattr(viz.calibration_plots, "plot_calibration", broken)
+    (tmp_path / "c2").mkdir()
+    (tmp_path / "c2" / "calibration.png").write_bytes(b"an earlier fit's")
     assert main(["calibrate", "--out", str(tmp_path / "c2"), "--install"]) == 1
     err = capsys.readouterr().err
     assert "twin: could not draw calibration.png: RuntimeError: matplotlib says no" in err
+    assert sorted(p.name for p in (tmp_path / "c2").iterdir()) == [".twin.lock", "as_built.json"]
+    monkeypatch.setattr(viz.calibration_plots, "plot_calibration", lambda data, path: path.write_bytes(b"png"))
+    assert main(["calibrate", "--out", str(tmp_path / "c2")]) == 0
+    assert sorted(p.name for p in (tmp_path / "c2").iterdir()) == [".twin.lock", "as_built.json", "calibration.png"]
     assert json.loads(preset.read_text()) == {"fitted": {"stiction": 1.0}}
     assert (tmp_path / "c2" / "as_built.json").read_text() == preset.read_text()
 

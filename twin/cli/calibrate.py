@@ -5,7 +5,9 @@ from __future__ import annotations
 import argparse
 import os
 import pathlib
+import shutil
 import sys
+import tempfile
 
 from twin.cli.common import output_folder
 from twin.exceptions import InvalidScenario
@@ -34,7 +36,16 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         if args.install:
             calibrate.write(data, preset.parent, name=preset.name)  # whole or not at all (a rename)
         failures: list[tuple[str, str]] = []
-        figures = drawn(lambda png: plot_calibration(data, png), args.out / "calibration.png", failures)
+        staging = pathlib.Path(tempfile.mkdtemp(prefix=".calibrate-", dir=args.out))
+        try:  # drawn beside the folder's files, then renamed in: no part-written figure
+            figures = drawn(lambda png: plot_calibration(data, png), staging / "calibration.png", failures)
+            for figure in figures:
+                os.replace(figure, args.out / figure.name)
+            figures = [args.out / figure.name for figure in figures]
+            for name, _ in failures:  # an earlier fit's figure must not pass for this one's
+                (args.out / name).unlink(missing_ok=True)
+        finally:
+            shutil.rmtree(staging, ignore_errors=True)
     print(calibrate.format_residuals(data))
     print(f"wrote {', '.join(str(p) for p in [path, *figures])} ({result.evaluations} evaluations, "
           f"{result.wall_time:.0f} s)")

@@ -172,9 +172,9 @@ def output_folder(out: pathlib.Path, *, keep_on_failure: bool = False):
                 if made and not keep_on_failure:
                     shutil.rmtree(out, ignore_errors=True)
                 raise
-    except OSError:
+    except OSError:  # the lock file could not be made (nothing was written), or handled above already
         if made and not keep_on_failure:
-            shutil.rmtree(out, ignore_errors=True)  # the lock could not be taken: nothing was written
+            shutil.rmtree(out, ignore_errors=True)
         raise
 
 
