@@ -172,11 +172,14 @@ def run_forked(calls: Sequence[tuple[Callable, tuple]], workers: int, on_done: C
 
 
 def worker_setup() -> None:
-    """In a worker: Ctrl-C is the parent's to handle (it stops the workers itself). A worker also dies
+    """In a worker: Ctrl-C is the parent's to handle (it stops the workers itself), and SIGTERM (sent to the
+    whole process group by a scheduler) ends a worker quietly instead of raising KeyboardInterrupt in it
+    as the parent's handler would. A worker also dies
     with its parent (Linux's parent-death signal): a worker outliving a SIGKILLed sweep would hold the
     inherited lock on the output folder, and the resume would be refused."""
     parent = os.getppid()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's Ctrl-C stand-in: a SIGTERM just ends a worker
     try:
         import ctypes
 

@@ -29,28 +29,27 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
         print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
 
-    with output_folder(args.out):
+    with output_folder(args.out) as folder:
         result = calibrate.calibrate(workers=args.workers, progress=progress)
         data = calibrate.record(result)
         path = calibrate.write(data, args.out)
+        folder.keep = True  # a finished fit stays, whatever happens after
+        print(calibrate.format_residuals(data))
+        print(f"wrote {path} ({result.evaluations} evaluations, {result.wall_time:.0f} s)")
         if args.install:
             calibrate.write(data, preset.parent, name=preset.name)  # whole or not at all (a rename)
+            print(f"installed as the as-built preset: {preset}")
         failures: list[tuple[str, str]] = []
         staging = pathlib.Path(tempfile.mkdtemp(prefix=".calibrate-", dir=args.out))
         try:  # drawn beside the folder's files, then renamed in: no part-written figure
             figures = drawn(lambda png: plot_calibration(data, png), staging / "calibration.png", failures)
             for figure in figures:
                 os.replace(figure, args.out / figure.name)
-            figures = [args.out / figure.name for figure in figures]
+                print(f"wrote {args.out / figure.name}")
             for name, _ in failures:  # an earlier fit's figure must not pass for this one's
                 (args.out / name).unlink(missing_ok=True)
         finally:
             shutil.rmtree(staging, ignore_errors=True)
-    print(calibrate.format_residuals(data))
-    print(f"wrote {', '.join(str(p) for p in [path, *figures])} ({result.evaluations} evaluations, "
-          f"{result.wall_time:.0f} s)")
-    if args.install:
-        print(f"installed as the as-built preset: {preset}")
     for name, reason in failures:
         print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
     return 1 if failures else 0

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import contextlib
+import dataclasses
 import os
 import pathlib
 import shutil
@@ -149,7 +150,17 @@ def sigterm_as_interrupt():
     try:
         yield
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        if previous is not None:  # None: a handler set outside Python, which cannot be put back from here
+            signal.signal(signal.SIGTERM, previous)
+
+
+@dataclasses.dataclass
+class OutputFolder:
+    """What :func:`output_folder` yields: whether the command made the folder, and whether to keep it
+    if the block fails from here on (set ``keep`` once a result worth keeping is in it)."""
+
+    made: bool
+    keep: bool
 
 
 @contextlib.contextmanager
@@ -157,23 +168,26 @@ def output_folder(out: pathlib.Path, *, keep_on_failure: bool = False):
     """A command's ``--out`` for the ``with`` block: made if it does not exist (atomically, so two
     commands cannot both think they made it), its lock held (one writer; taking it also finds out, before
     any work, that no file can be made there), SIGTERM taken as Ctrl-C. If the block fails or is
-    stopped, a folder made here is removed again while the lock is still held, unless
-    ``keep_on_failure`` (a store of finished runs). Yields whether the folder was made here."""
+    stopped, a folder made here is removed again while the lock is still held, unless the yielded
+    :class:`OutputFolder`'s ``keep`` is set (``keep_on_failure``: from the start, for a store of finished
+    runs)."""
     try:
         out.mkdir()
         made = True
     except FileExistsError:
         made = False
+    folder, entered = OutputFolder(made=made, keep=keep_on_failure), False
     try:
         with sigterm_as_interrupt(), folder_lock(out):
+            entered = True
             try:
-                yield made
+                yield folder
             except BaseException:
-                if made and not keep_on_failure:
+                if folder.made and not folder.keep:
                     shutil.rmtree(out, ignore_errors=True)
                 raise
-    except OSError:  # the lock file could not be made (nothing was written), or handled above already
-        if made and not keep_on_failure:
+    except OSError:
+        if not entered and folder.made and not folder.keep:  # the lock file could not be made: nothing written
             shutil.rmtree(out, ignore_errors=True)
         raise
 

@@ -63,8 +63,9 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
     from viz.sweep_plots import plot_summary
 
     summary = tables.summarise(outcome.records)
-    # The tables and the plot are written beside the folder's files, then renamed into place together:
-    # a stop or a full disk leaves the earlier sweep's set whole (the store keeps every finished scenario).
+    # The tables and the plot are written beside the folder's files, then renamed into place one after another
+    # once all are written: a stop or a full disk while they are written leaves the earlier sweep's set whole
+    # (and the store keeps every finished scenario).
     staging = pathlib.Path(tempfile.mkdtemp(prefix=".sweep-", dir=args.out))
     undrawn: list[tuple[str, str]] = []
     try:

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
+import errno
 import os
 import pathlib
 import shutil
@@ -104,17 +105,28 @@ class Experiment:
             shutil.rmtree(staging, ignore_errors=True)
 
 
+DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS, errno.EACCES, errno.EPERM})
+
+
 def drawn(draw: Callable[[pathlib.Path], None], path: pathlib.Path,
           undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
     """``draw(path)``: the figure at ``path``, best effort: ``[path]``, or ``[]`` with (its name, the reason)
-    added to ``undrawn`` when the drawing fails. A failing disk (OSError) and a stop (KeyboardInterrupt,
-    which is no Exception) still stop the whole publication."""
+    added to ``undrawn`` when the drawing fails. The disk failing (an OSError of :data:`DISK_ERRORS`: full,
+    read-only, refused) and a stop (KeyboardInterrupt, which is no Exception) still stop the whole
+    publication; any other error, a plotting library's own OSErrors included (a font file, an image
+    encoder), only costs the figure."""
     try:
         draw(path)
-    except OSError:
-        raise
+    except OSError as error:
+        if error.errno in DISK_ERRORS:
+            raise
+        return _left_out(path, error, undrawn)
     except Exception as error:  # noqa: BLE001 - a plotting library's error of any kind must not cost the tables
-        path.unlink(missing_ok=True)
-        undrawn.append((path.name, f"{type(error).__name__}: {error}".splitlines()[0]))
-        return []
+        return _left_out(path, error, undrawn)
     return [path]
+
+
+def _left_out(path: pathlib.Path, error: Exception, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
+    path.unlink(missing_ok=True)
+    undrawn.append((path.name, f"{type(error).__name__}: {error}".splitlines()[0]))
+    return []

@@ -5,9 +5,11 @@ over several noise seeds, in one batch; prints RMSE, SSE and max error (mean
 and std over seeds) beside the thesis's simulated values (SPEC §8), and writes
 into the output folder: ``results.csv`` (one row per run), ``summary.md`` (the
 table) and one PNG per run. They are written beside the folder's files first and
-renamed into place together once all are written (so a stop or a full disk leaves
-the folder as it was), and the PNGs of an earlier demo run in that folder that this
-run did not draw (fewer seeds, ``--no-plots``) are removed: the folder shows one run.
+renamed into place one after another once all are written (so a stop or a full disk
+while they are written leaves the folder as it was). In a folder an earlier demo
+wrote (its ``summary.md`` says so), that run's PNGs that this run did not draw (fewer
+seeds, ``--no-plots``) are removed: the folder shows one run. Elsewhere nothing but
+this run's files is touched.
 """
 
 from __future__ import annotations
@@ -102,8 +104,13 @@ def markdown_table(rows: list[dict]) -> str:
 RUN_FIGURE = re.compile(rf"({'|'.join(CONTROLLER_NAMES)})_T[1-4]_seed\d+\.png")  # the name of a run's PNG
 
 
+SUMMARY_TITLE = "# Thesis controller comparison on the twin"  # summary.md's first words: a demo wrote the folder
+
+
 def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
     out.mkdir(parents=True, exist_ok=True)
+    summary = out / "summary.md"
+    demo_folder = summary.is_file() and summary.read_text(errors="replace").startswith(SUMMARY_TITLE)
     scenarios = demo_scenarios(seeds)
     print(f"Simulating {len(scenarios)} runs on the 'thesis' plant; output in {out.resolve()}", file=sys.stderr)
     with tqdm(total=1, desc="simulating", unit="tick", file=sys.stderr, dynamic_ncols=True) as bar:
@@ -129,7 +136,7 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
                     writer.writeheader()
                 writer.writerow(record)
         (staging / "summary.md").write_text(
-            f"# Thesis controller comparison on the twin ('thesis' plant, {seeds} seeds)\n\n{table}\n")
+            f"{SUMMARY_TITLE} ('thesis' plant, {seeds} seeds)\n\n{table}\n")
         names = ["results.csv", "summary.md"]
         undrawn: list[tuple[str, str]] = []
         if plots:
@@ -143,7 +150,7 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
             os.replace(staging / name, out / name)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
-    for stale in out.iterdir():  # an earlier run's figures that this run did not draw
+    for stale in out.iterdir() if demo_folder else ():  # an earlier demo's figures that this run did not draw
         if RUN_FIGURE.fullmatch(stale.name) and stale.name not in names:
             stale.unlink(missing_ok=True)
     print(table)
