@@ -50,12 +50,9 @@ def main() -> None:
     best = calibrated_values()
     points = [("committed", best)] + [(f"load {x:.2f}", {**best, "load_friction": x}) for x in LOAD_FRICTIONS]
     all_seeds = tuple(s for seeds in SEED_SETS for s in seeds)
-    evaluator = calibrate.Evaluator(seeds=all_seeds, workers=2)
-    try:
+    with calibrate.Evaluator(seeds=all_seeds, workers=2) as evaluator:
         cells = {name: evaluator.cells(values) for name, values in points}
         t3 = {name: evaluator.cells(values, keys=T3_VERTICAL, seeds=range(5)) for name, values in points}
-    finally:
-        evaluator.close()
     rng = np.random.default_rng(0)
     draws = [{t.key: max(rng.normal(t.rmse_deg, t.rmse_std_deg / math.sqrt(calibrate.THESIS_RUNS)), 0.05)
               for t in calibrate.TARGETS} for _ in range(DRAWS)]

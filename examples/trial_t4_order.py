@@ -19,8 +19,7 @@ FRESH = tuple(range(40, 80))
 
 
 def main() -> None:
-    evaluator = calibrate.Evaluator(seeds=tuple(range(5)), workers=2)
-    try:
+    with calibrate.Evaluator(seeds=tuple(range(5)), workers=2) as evaluator:
         for k, m in enumerate(ensemble_values()):
             five = evaluator.cells(m, keys=KEYS)
             fresh = evaluator.cells(m, keys=KEYS, seeds=FRESH)
@@ -28,8 +27,6 @@ def main() -> None:
                   f"leak {m['leak_conductance'] * 1e14:.2f}e-14 | seeds 0-4: FF + PVA {five[0].mean_rmse:.3f}, "
                   f"SMC {five[1].mean_rmse:.3f} | seeds 40-79: FF + PVA {fresh[0].mean_rmse:.3f}, "
                   f"SMC {fresh[1].mean_rmse:.3f}", flush=True)
-    finally:
-        evaluator.close()
 
 
 if __name__ == "__main__":

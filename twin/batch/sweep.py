@@ -152,9 +152,7 @@ def run_forked(calls: Sequence[tuple[Callable, tuple]], workers: int, on_done: C
     from twin.sim.plant_state import compile_kernels
 
     compile_kernels()
-    context = multiprocessing.get_context("fork")
-    pool = concurrent.futures.ProcessPoolExecutor(max_workers=max(1, min(workers, len(calls))), mp_context=context,
-                                                  initializer=worker_setup)
+    pool = fork_pool(max(1, min(workers, len(calls))))
     try:
         futures = [pool.submit(function, *arguments) for function, arguments in calls]
         for future in concurrent.futures.as_completed(futures):
@@ -162,13 +160,24 @@ def run_forked(calls: Sequence[tuple[Callable, tuple]], workers: int, on_done: C
     except BaseException:
         # Ctrl-C, SIGTERM or an error: what finished has been handed to on_done; the calls in flight are
         # lost (at most one per worker), and the workers are stopped now rather than waited for.
-        processes = list((getattr(pool, "_processes", None) or {}).values())
-        pool.shutdown(wait=False, cancel_futures=True)
-        for process in processes:
-            process.kill()
+        kill_pool(pool)
         raise
     else:
         pool.shutdown(wait=True)
+
+
+def fork_pool(workers: int) -> concurrent.futures.ProcessPoolExecutor:
+    """A pool of ``workers`` forked processes, each set up by :func:`worker_setup`."""
+    return concurrent.futures.ProcessPoolExecutor(max_workers=workers, mp_context=multiprocessing.get_context("fork"),
+                                                  initializer=worker_setup)
+
+
+def kill_pool(pool: concurrent.futures.ProcessPoolExecutor) -> None:
+    """Stop ``pool`` now: its queued calls cancelled, its workers killed rather than waited for."""
+    processes = list((getattr(pool, "_processes", None) or {}).values())
+    pool.shutdown(wait=False, cancel_futures=True)
+    for process in processes:
+        process.kill()
 
 
 def worker_setup() -> None:

@@ -5,14 +5,12 @@ from __future__ import annotations
 import argparse
 import os
 import pathlib
-import shutil
 import sys
-import tempfile
 
 from twin.cli.common import output_folder
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
-from twin.experiments.base import drawn
+from twin.experiments.base import staged, tell_undrawn
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
@@ -39,20 +37,12 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         if args.install:
             calibrate.write(data, preset.parent, name=preset.name)  # whole or not at all (a rename)
             print(f"installed as the as-built preset: {preset}")
-        failures: list[tuple[str, str]] = []
-        staging = pathlib.Path(tempfile.mkdtemp(prefix=".calibrate-", dir=args.out))
-        try:  # drawn beside the folder's files, then renamed in: no part-written figure
-            figures = drawn(lambda png: plot_calibration(data, png), staging / "calibration.png", failures)
-            for figure in figures:
-                os.replace(figure, args.out / figure.name)
-                print(f"wrote {args.out / figure.name}")
-            for name, _ in failures:  # an earlier fit's figure must not pass for this one's
-                (args.out / name).unlink(missing_ok=True)
-        finally:
-            shutil.rmtree(staging, ignore_errors=True)
-    for name, reason in failures:
-        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
-    return 1 if failures else 0
+        with staged(args.out, "calibrate") as stage:  # drawn beside the folder's files, then renamed in
+            stage.figure("calibration.png", lambda png: plot_calibration(data, png))
+    for name in stage.names:
+        print(f"wrote {args.out / name}")
+    tell_undrawn(stage.undrawn)
+    return 1 if stage.undrawn else 0
 
 
 def add_parser(sub) -> None:

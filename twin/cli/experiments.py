@@ -8,7 +8,7 @@ import sys
 
 from twin.cli.common import EXIT_INTERRUPTED, Parser, output_folder
 from twin.experiments import arguments
-from twin.experiments.base import Experiment
+from twin.experiments.base import Experiment, tell_undrawn
 from twin.experiments.studies import STUDIES
 from twin.experiments.whatifs import WHATIFS
 
@@ -31,8 +31,7 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
         paths, undrawn = experiment.publish(outcome, args.out)  # every table, or none
     print(outcome.answer)
     print(f"wrote {', '.join(str(p) for p in paths)}")
-    for name, reason in undrawn:
-        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
+    tell_undrawn(undrawn)
     return 1 if outcome.failed or undrawn else 0
 
 

@@ -4,16 +4,13 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import os
 import pathlib
-import shutil
 import sys
-import tempfile
 
 from twin.cli.common import EXIT_INTERRUPTED, output_folder
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
-from twin.experiments.base import drawn
+from twin.experiments.base import staged, tell_undrawn
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
@@ -66,28 +63,19 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
     # The tables and the plot are written beside the folder's files, then renamed into place one after another
     # once all are written: a stop or a full disk while they are written leaves the earlier sweep's set whole
     # (and the store keeps every finished scenario).
-    staging = pathlib.Path(tempfile.mkdtemp(prefix=".sweep-", dir=args.out))
-    undrawn: list[tuple[str, str]] = []
-    try:
-        tables.write_results(outcome.records, staging)
-        tables.write_summary(summary, staging)
-        names = ["results.csv", "results.parquet", "summary.csv"]
-        names += [p.name for p in drawn(lambda path: plot_summary(summary, path), staging / "rmse.png", undrawn)]
-        for name in names:
-            os.replace(staging / name, args.out / name)
-        for name, _ in undrawn:  # an earlier sweep's plot must not pass for this one's
-            (args.out / name).unlink(missing_ok=True)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+    with staged(args.out, "sweep") as stage:
+        tables.write_results(outcome.records, stage.folder)
+        tables.write_summary(summary, stage.folder)
+        stage.names += ["results.csv", "results.parquet", "summary.csv"]
+        stage.figure("rmse.png", lambda path: plot_summary(summary, path))
     print(tables.format_summary(summary))
     failed = [r for r in outcome.records if r["status"] != "ok"]
     for r in failed[:20]:
         print(f"failed: {r['key']}: {r['reason']}", file=sys.stderr)
-    for name, reason in undrawn:
-        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
+    tell_undrawn(stage.undrawn)
     print(f"{outcome.ran} run, {outcome.skipped} already done, {len(failed)} failed; "
-          f"wrote {', '.join(names)} in {args.out}")
-    return 1 if failed or undrawn else 0
+          f"wrote {', '.join(map(str, stage.names))} in {args.out}")
+    return 1 if failed or stage.undrawn else 0
 
 
 def add_parser(sub) -> None:

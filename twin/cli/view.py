@@ -3,11 +3,17 @@
 from __future__ import annotations
 
 import argparse
-import signal
 import sys
 import time
 
-from twin.cli.common import EXIT_INTERRUPTED, add_scenario_arguments, compare_of, compare_settings, scenario_from
+from twin.cli.common import (
+    EXIT_INTERRUPTED,
+    add_scenario_arguments,
+    compare_of,
+    compare_settings,
+    scenario_from,
+    sigterm_as_interrupt,
+)
 from twin.experiments import arguments
 
 
@@ -23,20 +29,20 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if args.duration is not None:
         stop_at = time.monotonic() + args.duration
         viewer.on_frame = lambda: viewer.shutdown() if time.monotonic() >= stop_at else None
-    signal.signal(signal.SIGTERM, signal.default_int_handler)  # stop (and write --html) on SIGTERM too
-    try:
-        viewer.start()
-    except KeyboardInterrupt:
-        viewer.stop()
-    print("twin view: stopped", flush=True)
-    if args.html is not None:
-        print(f"writing {args.html} ...", flush=True)
+    with sigterm_as_interrupt():  # stop (and write --html) on SIGTERM too
         try:
-            session.write_html(args.html)
+            viewer.start()
         except KeyboardInterrupt:
-            print("twin view: interrupted; no recording written", file=sys.stderr)
-            return EXIT_INTERRUPTED
-        print(f"wrote {args.html}", flush=True)
+            viewer.stop()
+        print("twin view: stopped", flush=True)
+        if args.html is not None:
+            print(f"writing {args.html} ...", flush=True)
+            try:
+                session.write_html(args.html)
+            except KeyboardInterrupt:
+                print("twin view: interrupted; no recording written", file=sys.stderr)
+                return EXIT_INTERRUPTED
+            print(f"wrote {args.html}", flush=True)
     return 1 if viewer.failure else 0
 
 

@@ -20,11 +20,13 @@ registered in :mod:`twin.experiments.whatifs`.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import errno
 import os
 import pathlib
 import shutil
+import sys
 import tempfile
 from collections.abc import Callable
 from typing import Any, ClassVar
@@ -85,24 +87,52 @@ class Experiment:
         return []
 
     def publish(self, outcome: Outcome, out: pathlib.Path) -> tuple[list[pathlib.Path], list[tuple[str, str]]]:
-        """:meth:`outputs` all or nothing: written into a staging folder inside ``out``, then each file
-        renamed into ``out`` (renames need no space); if any write fails (a full disk, an interrupt), the
-        staging folder goes and ``out`` keeps what it had. A figure whose drawing fails otherwise (a
-        plotting library's error) is left out instead, so the tables are not lost with it. Returns the
-        final paths, in :meth:`outputs`'s order, then :meth:`kept`; and the figures left out, as
-        (file name, reason)."""
-        staging = pathlib.Path(tempfile.mkdtemp(prefix=f".{self.name}-", dir=out))
-        undrawn: list[tuple[str, str]] = []
-        try:
-            staged = self.outputs(outcome, staging, undrawn)
-            final = [out / path.relative_to(staging) for path in staged]
-            for path, target in zip(staged, final, strict=True):
-                os.replace(path, target)
-            for name, _ in undrawn:  # an earlier run's figure must not pass for this run's
-                (out / name).unlink(missing_ok=True)
-            return final + self.kept(out), undrawn
-        finally:
-            shutil.rmtree(staging, ignore_errors=True)
+        """:meth:`outputs` all or nothing (:func:`staged`), but for a figure whose drawing fails otherwise
+        than by the disk, which is left out so that the tables are not lost with it. Returns the final
+        paths, in :meth:`outputs`'s order, then :meth:`kept`; and the figures left out, as (file name,
+        reason)."""
+        with staged(out, self.name) as stage:
+            stage.names += [path.relative_to(stage.folder) for path in self.outputs(outcome, stage.folder,
+                                                                                    stage.undrawn)]
+        return [out / name for name in stage.names] + self.kept(out), stage.undrawn
+
+
+@dataclasses.dataclass
+class Staging:
+    """What :func:`staged` yields: the staging ``folder`` to write into, the ``names`` (relative paths)
+    written there that go into place, and the figures left out (:func:`drawn`)."""
+
+    folder: pathlib.Path
+    names: list[pathlib.Path | str] = dataclasses.field(default_factory=list)
+    undrawn: list[tuple[str, str]] = dataclasses.field(default_factory=list)
+
+    def figure(self, name: str, draw: Callable[[pathlib.Path], None]) -> None:
+        """``draw`` the figure ``name`` into the staging folder, best effort (:func:`drawn`)."""
+        self.names += [path.name for path in drawn(draw, self.folder / name, self.undrawn)]
+
+
+@contextlib.contextmanager
+def staged(out: pathlib.Path, prefix: str):
+    """A set of outputs put into ``out`` all or nothing: written into a staging folder inside ``out``
+    (the :class:`Staging` yielded), then, once the block has written them all, each renamed into ``out``
+    (renames need no space) and an earlier run's copy of each figure left out removed (it must not pass for
+    this run's). If any write fails (a full disk, an interrupt), ``out`` keeps what it had. The staging
+    folder goes either way."""
+    stage = Staging(pathlib.Path(tempfile.mkdtemp(prefix=f".{prefix}-", dir=out)))
+    try:
+        yield stage
+        for name in stage.names:
+            os.replace(stage.folder / name, out / name)
+        for name, _ in stage.undrawn:
+            (out / name).unlink(missing_ok=True)
+    finally:
+        shutil.rmtree(stage.folder, ignore_errors=True)
+
+
+def tell_undrawn(undrawn: list[tuple[str, str]]) -> None:
+    """One line on stderr for each figure left out."""
+    for name, reason in undrawn:
+        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
 
 
 DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EIO, errno.EROFS, errno.EACCES, errno.EPERM})

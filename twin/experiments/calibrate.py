@@ -42,11 +42,9 @@ Search, deterministic (the same code and seeds give the same file):
 
 from __future__ import annotations
 
-import concurrent.futures
 import dataclasses
 import json
 import math
-import multiprocessing
 import os
 import pathlib
 import time
@@ -54,7 +52,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from twin.batch.sweep import code_version, worker_setup
+from twin.batch.sweep import code_version, fork_pool, kill_pool
 from twin.experiments.reference import (
     THESIS_EXPERIMENT_RMSE_DEG,
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
@@ -186,10 +184,18 @@ class Evaluator:
 
     def __init__(self, *, seeds: Sequence[int], workers: int, cells: Sequence[tuple] = CELLS):
         self.seeds, self.workers, self.keys = tuple(seeds), workers, tuple(cells)
-        # worker_setup: Ctrl-C is the parent's to handle, and a worker dies with its parent
-        self.pool = (concurrent.futures.ProcessPoolExecutor(workers, mp_context=multiprocessing.get_context("fork"),
-                                                            initializer=worker_setup)
-                     if workers > 1 else None)
+        self.pool = fork_pool(workers) if workers > 1 else None  # as a sweep's: Ctrl-C is the parent's
+
+    def __enter__(self) -> Evaluator:
+        return self
+
+    def __exit__(self, kind, error, traceback) -> None:
+        """The ``with`` block's end: :meth:`close` when its work is done, :meth:`abort` when it failed or
+        was stopped."""
+        if kind is None:
+            self.close()
+        else:
+            self.abort()
 
     def close(self) -> None:
         """Let the workers finish and go (the work is done)."""
@@ -200,10 +206,7 @@ class Evaluator:
         """Stop the workers now, without waiting for the share each may be running (on Ctrl-C, SIGTERM or
         an error: nobody will read it)."""
         if self.pool is not None:
-            processes = list((getattr(self.pool, "_processes", None) or {}).values())
-            self.pool.shutdown(wait=False, cancel_futures=True)
-            for process in processes:
-                process.kill()
+            kill_pool(self.pool)
 
     def cells(self, values: dict[str, float], *, without: Sequence[str] = (), seeds: Sequence[int] | None = None,
               keys: Sequence[tuple] | None = None) -> list[CellResult]:
@@ -379,7 +382,7 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
     def lowest() -> tuple[float, ...]:
         return min(seen, key=lambda k: seen[k][0].cost)
 
-    try:
+    with evaluator:  # its workers killed, not waited for, if the fit fails or is stopped
         design = qmc.Sobol(len(FITTED), scramble=True, seed=SCAN_SEED).random(scan_points) if scan_points else []
         for u in [np.full(len(FITTED), 0.5), *design]:
             objective(u)
@@ -411,10 +414,6 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
         best, fit_cells = seen[lowest()]
         check_cells = _cells_of(fit_cells, check_seeds) or (evaluator.cells(best.values, seeds=check_seeds)
                                                             if check_seeds else [])
-    except BaseException:
-        evaluator.abort()
-        raise
-    evaluator.close()
     return Calibration(values=best.values, cost=best.cost, evaluations=len(history), history=history,
                        fit_cells=fit_cells, check_cells=check_cells, noise_costs=noise_costs,
                        ensemble=choose_ensemble(history, best, cost_noise(noise_costs)),

@@ -15,18 +15,15 @@ this run's files is touched.
 from __future__ import annotations
 
 import csv
-import os
 import pathlib
 import re
-import shutil
 import sys
-import tempfile
 
 import numpy as np
 from tqdm import tqdm
 
 from twin.envs.runner import run_many
-from twin.experiments.base import drawn
+from twin.experiments.base import staged, tell_undrawn
 from twin.experiments.reference import (
     THESIS_SIMULATED_RMSE_DEG,
     THESIS_SIMULATED_SSE_T1_DEG,
@@ -123,9 +120,8 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
 
     rows = summary_rows(results)
     table = markdown_table(rows) + "\n\n" + rest_error_table(results)
-    staging = pathlib.Path(tempfile.mkdtemp(prefix=".demo-", dir=out))
-    try:
-        with open(staging / "results.csv", "w", newline="") as handle:
+    with staged(out, "demo") as stage:
+        with open(stage.folder / "results.csv", "w", newline="") as handle:
             writer = None
             for result in results:
                 record = report.summary(result)
@@ -135,30 +131,23 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
                     writer = csv.DictWriter(handle, fieldnames=list(record))
                     writer.writeheader()
                 writer.writerow(record)
-        (staging / "summary.md").write_text(
-            f"{SUMMARY_TITLE} ('thesis' plant, {seeds} seeds)\n\n{table}\n")
-        names = ["results.csv", "summary.md"]
-        undrawn: list[tuple[str, str]] = []
+        (stage.folder / "summary.md").write_text(f"{SUMMARY_TITLE} ('thesis' plant, {seeds} seeds)\n\n{table}\n")
+        stage.names += ["results.csv", "summary.md"]
         if plots:
             from viz.plots import plot_run
 
             for result in tqdm(results, desc="plotting", unit="png", file=sys.stderr, dynamic_ncols=True):
                 s = result.scenario
-                png = staging / f"{s.controller}_T{s.trajectory}_seed{s.seed}.png"
-                names += [path.name for path in drawn(lambda path, r=result: plot_run(r, path), png, undrawn)]
-        for name in names:
-            os.replace(staging / name, out / name)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
+                stage.figure(f"{s.controller}_T{s.trajectory}_seed{s.seed}.png",
+                             lambda path, r=result: plot_run(r, path))
     for stale in out.iterdir() if demo_folder else ():  # an earlier demo's figures that this run did not draw
-        if RUN_FIGURE.fullmatch(stale.name) and stale.name not in names:
+        if RUN_FIGURE.fullmatch(stale.name) and stale.name not in stage.names:
             stale.unlink(missing_ok=True)
     print(table)
     failed = [r for r in results if r.warnings]
     for r in failed:
         print(f"warning: {r.scenario}: {', '.join(r.warnings)}", file=sys.stderr)
-    for name, reason in undrawn:
-        print(f"twin: could not draw {name}: {reason}", file=sys.stderr)
+    tell_undrawn(stage.undrawn)
     print(f"\nWrote {out / 'results.csv'}, {out / 'summary.md'}"
-          + (f" and {len(names) - 2} PNGs" if plots else ""))
-    return 1 if failed or undrawn else 0
+          + (f" and {len(stage.names) - 2} PNGs" if plots else ""))
+    return 1 if failed or stage.undrawn else 0

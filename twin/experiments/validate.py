@@ -199,10 +199,6 @@ def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.Ce
         s = spread(cell.rmse_deg)
         groups = [cell.rmse_deg[i:i + n] for i in range(0, len(cell.rmse_deg) - n + 1, n)]
         means = [float(np.mean(g)) for g in groups if all(math.isfinite(x) for x in g)]
-
-        def within(x: float, measured: float = target.rmse_deg) -> bool:
-            return rmse_within(x, measured)
-
         mine = five_of.get(cell.key)
         row = {"controller": cell.controller, "trajectory": cell.trajectory, "payload_g": cell.payload_g,
                "orientation": cell.orientation, "measured": target.rmse_deg,
@@ -213,7 +209,8 @@ def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.Ce
                "twin_mean": s.mean, "twin_std": s.std,
                "spread_within": target.rmse_std_deg * low <= s.std <= target.rmse_std_deg * high,
                "ratio": s.mean / target.rmse_deg,
-               "within_tolerance": within(s.mean), "groups_within": sum(within(m) for m in means),
+               "within_tolerance": rmse_within(s.mean, target.rmse_deg),
+               "groups_within": sum(rmse_within(m, target.rmse_deg) for m in means),
                "groups": len(means), "group_low": min(means, default=None), "group_high": max(means, default=None),
                "group_means": means, "sse_measured": None, "sse_five_run": None, "sse_twin": None,
                "sse_within_tolerance": None, "sse_groups_within": None, "sse_group_low": None,
@@ -785,8 +782,7 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
     rows = simulation_rows()
     step()
     committed = calibrated_values()
-    evaluator = calibrate.Evaluator(seeds=SEEDS, workers=workers)
-    try:
+    with calibrate.Evaluator(seeds=SEEDS, workers=workers) as evaluator:
         cells = evaluator.cells(committed)
         rows += measured_rows(cells)
         step()
@@ -808,10 +804,6 @@ def validate(*, workers: int = 2, progress=None) -> Validation:
         phases = payload_phases(committed)
         step()
         predicted, own, detail = prediction(evaluator, committed, progress=step, ran=cells)
-    except BaseException:
-        evaluator.abort()
-        raise
-    evaluator.close()
     failed = sum(c.failed for c in (*cells, *fresh, *own)) + sum(len(run.warnings) > 0 for run in study.runs)
     failed += sum(run["warnings"] > 0 for r in full_duty for run in r["runs"].values())
     failed += sum(r["failed_runs"] for r in phases)

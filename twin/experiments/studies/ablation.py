@@ -49,9 +49,8 @@ def ablation_study(*, seeds: Sequence[int] = CHECK_SEEDS, workers: int = 2,
                    progress: Callable[[int, int, str], None] | None = None) -> Ablation:
     """``progress(done, total, variant)`` after each variant."""
     values = calibrated_values()
-    evaluator = Evaluator(seeds=seeds, workers=workers, cells=EXPERIMENT_CELLS)
     rows = []
-    try:
+    with Evaluator(seeds=seeds, workers=workers, cells=EXPERIMENT_CELLS) as evaluator:
         for done, (label, off) in enumerate(variants(), start=1):
             cells = evaluator.cells(values, without=off)
             for cell, row in zip(cells, cell_rows(cells), strict=True):
@@ -59,10 +58,6 @@ def ablation_study(*, seeds: Sequence[int] = CHECK_SEEDS, workers: int = 2,
                 rows.append({"variant": label, **row, "within_tolerance": within})
             if progress is not None:
                 progress(done, len(variants()), label)
-    except BaseException:
-        evaluator.abort()
-        raise
-    evaluator.close()
     return Ablation(rows=rows, seeds=tuple(seeds))
 
 
