@@ -26,8 +26,10 @@ import errno
 import os
 import pathlib
 import shutil
+import signal
 import sys
 import tempfile
+import threading
 from collections.abc import Callable
 from typing import Any, ClassVar
 
@@ -117,16 +119,40 @@ def staged(out: pathlib.Path, prefix: str):
     (the :class:`Staging` yielded), then, once the block has written them all, each renamed into ``out``
     (renames need no space) and an earlier run's copy of each figure left out removed (it must not pass for
     this run's). If any write fails (a full disk, an interrupt), ``out`` keeps what it had. The staging
-    folder goes either way."""
+    folder goes either way. A Ctrl-C or SIGTERM that comes while the set is being renamed in waits until
+    it is in (:func:`stops_held`), so it never mixes an old set with a new one."""
     stage = Staging(pathlib.Path(tempfile.mkdtemp(prefix=f".{prefix}-", dir=out)))
     try:
         yield stage
-        for name in stage.names:
-            os.replace(stage.folder / name, out / name)
-        for name, _ in stage.undrawn:
-            (out / name).unlink(missing_ok=True)
+        with stops_held():
+            for name in stage.names:
+                os.replace(stage.folder / name, out / name)
+            for name, _ in stage.undrawn:
+                (out / name).unlink(missing_ok=True)
     finally:
         shutil.rmtree(stage.folder, ignore_errors=True)
+
+
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+@contextlib.contextmanager
+def stops_held():
+    """Hold Ctrl-C and SIGTERM for the block and deliver them when it ends, once each in the order they
+    came, to the handlers they had: for a few renames that must all happen or none. Python runs signal handlers in the main
+    thread only, so outside it this holds nothing (no other thread can be stopped by one)."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    caught: list[int] = []
+    before = {signum: signal.signal(signum, lambda signum, _frame: caught.append(signum)) for signum in STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for signum, handler in before.items():
+            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
+        for signum in dict.fromkeys(caught):
+            signal.raise_signal(signum)
 
 
 def tell_undrawn(undrawn: list[tuple[str, str]]) -> None:
