@@ -28,7 +28,7 @@ import numpy as np
 from twin.experiments import calibrate
 from twin.plants.as_built import calibrated_values
 
-LOAD_FRICTIONS = (0.0, 0.15, 0.35, 0.40, 0.45, 0.60)  # N/N; the box is 0-0.6
+LOAD_FRICTIONS = (0.0, 0.15, 0.20, 0.25, 0.35, 0.40, 0.45, 0.60)  # N/N; the box is 0-0.6
 SEED_SETS = (calibrate.FIT_SEEDS, *calibrate.NOISE_SEED_SETS)
 DRAWS = 2000
 T3_VERTICAL = [("ffpva", 3, 13.5, "vertical"), ("smc", 3, 13.5, "vertical")]
