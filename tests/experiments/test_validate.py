@@ -553,7 +553,7 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies():
     v, missed, text = _miss_report()
     read = {(m["comparison"], m["controller"], m["trajectory"], m["payload_g"], m["orientation"]): m for m in missed}
     assert [m["reading"] for m in missed] == ["largest error", "largest error", "draw", "opening lag", "base level",
-                                              "open", "draw", "scatter", "follows", "follows"]
+                                              "payload cost", "draw", "scatter", "follows", "follows"]
     assert [m["missed_on"] for m in missed] == ["seeds 0-4", "seeds 40-49 only", *["seeds 0-4"] * 6,
                                                 "seeds 40-49 only", "seeds 0-4"]
     pva1 = read[("RMSE", "pva", 1, 0.0, "horizontal")]
@@ -579,7 +579,23 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies():
     assert read[("RMSE", "smc", 1, 13.5, "vertical")]["what_the_twin_shows"] == (
         "on seeds 40-49, where this cell is x1.26, the payload's cost matches the rig's (x2.93 against x2.92) and its "
         "controller's 0 g flat cell is out the same way (x1.26)")
-    assert read[("RMSE", "ffpva", 1, 6.5, "horizontal")]["what_the_twin_shows"] == "none of the other checks explains it"
+    # FF + PVA 6.5 g flat: 2.5 / 1.69 = x1.48 on the fresh seeds; its cost 2.5 / 1.4 = x1.79 against 1.69 / 1.40 =
+    # x1.21, whose s.e. is 1.207 hypot(0.24 / sqrt 5 / 1.69, 0.06 / sqrt 5 / 1.40) = 0.080 (the twin's ten equal
+    # runs add none): +7.2 s.e.; the flat cell 1.4 / 1.40 = x1.00.
+    assert read[("RMSE", "ffpva", 1, 6.5, "horizontal")]["what_the_twin_shows"] == (
+        "on seeds 40-49, where this cell is x1.48, the payload costs the twin more than it cost the rig: x1.79 over "
+        "its controller's 0 g flat cell against x1.21 (+7.2 combined standard errors); that flat cell is x1.00, "
+        "within; why the payload costs the twin's law differently, the twin does not show")
+    v.phases = [{"controller": "ffpva", "payload_g": 0.0, "orientation": "horizontal", "move_deg": 2.0, "hold_deg": 1.0},
+                {"controller": "ffpva", "payload_g": 6.5, "orientation": "horizontal", "move_deg": 2.5, "hold_deg": 0.8}]
+    phased = next(m for m in validate.misses(v) if m["reading"] == "payload cost")["what_the_twin_shows"]
+    assert phased.endswith("that flat cell is x1.00, within. On seeds 0-4 the twin's cost falls in T1's move (the "
+                           "flat cell's RMS error times x1.25 over the move, x0.80 over the hold); why the payload "
+                           "costs the twin's law differently, the twin does not show")
+    v.phases[1]["hold_deg"] = 1.5
+    assert "falls in T1's hold (the flat cell's RMS error times x1.25 over the move, x1.50 over the hold)" in next(
+        m for m in validate.misses(v) if m["reading"] == "payload cost")["what_the_twin_shows"]
+    v.phases = None
     flat = read[("T1 SSE range", "ffpva", 1, 0.0, "horizontal")]
     assert flat["off_by"] == pytest.approx(-0.5) and flat["fresh"] == pytest.approx(0.7) and flat["fresh_within"]
     # Signed ends 1.7, 0, 0, 0, 0 twice: mean 0.34, std 0.717, so centred within half a std of zero.

@@ -1020,6 +1020,7 @@ READINGS = {
     "largest error": "§8's largest error is off the same way",  # a flat cell whose largest error is off by > 20 %
     "opening lag": "sliding mode's opening lag",  # sliding mode too high on a slow trajectory, opening no earlier
     "base level": "its 0 g flat level",  # a Chapter 6 cell: the payload's cost matches, its flat cell is out alike
+    "payload cost": "its payload's cost",  # a Chapter 6 cell: the payload costs the twin more (less) than the rig
     "scatter": "where the runs end scatters",  # an SSE range out on the fresh seeds too, their ends centred near 0
     "offset": "where the runs end is off zero",  # the same, their ends centred away from 0
     "follows": "follows from the cells that miss",  # an order that the measured values of its out cells restore
@@ -1081,7 +1082,27 @@ def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[d
             f"flat cell is out the same way (x{flat['ratio']:.2f})"
             + ("" if flat["five_run_mean"] is None else
                f"; on seeds 0-4 that flat cell is x{flat['five_run_mean'] / flat['measured']:.2f}"))
+    if (cost and flat and f and _loaded(r) and abs(cost["difference_in_se"]) > EFFECT_SIGNIFICANCE
+            and (cost["difference_in_se"] > 0) == high(f) == high(miss)):
+        phase = {(x["controller"], x["payload_g"], x["orientation"]): x for x in v.phases or []}
+        here = phase.get((r["controller"], r["payload_g"], r["orientation"]))
+        base = phase.get((r["controller"], 0.0, "horizontal"))
+        return "payload cost", (
+            f"on seeds {flat['seeds']}, where this cell is x{f['ratio']:.2f}, the payload costs the twin "
+            + ("more" if high(miss) else "less") + f" than it cost the rig: x{cost['twin_effect']:.2f} over its "
+            f"controller's 0 g flat cell against x{cost['measured_effect']:.2f} ({cost['difference_in_se']:+.1f} "
+            f"combined standard errors); that flat cell is x{flat['ratio']:.2f}"
+            + (", within" if flat["within_tolerance"] else ", out")
+            + ("" if not (here and base) else _phase_cost(here, base))
+            + "; why the payload costs the twin's law differently, the twin does not show")
     return "open", "none of the other checks explains it"
+
+
+def _phase_cost(here: dict, base: dict) -> str:
+    """Where in T1 a cell's cost over its flat cell (:func:`payload_phases`' rows ``here`` and ``base``) falls."""
+    move, hold = here["move_deg"] / base["move_deg"], here["hold_deg"] / base["hold_deg"]
+    return (f". On seeds 0-4 the twin's cost falls in T1's {'move' if move > hold else 'hold'} (the flat cell's RMS "
+            f"error times x{move:.2f} over the move, x{hold:.2f} over the hold)")
 
 
 def _sse_reading(r: dict, f: dict | None, v: Validation) -> tuple[str, str]:
@@ -1395,11 +1416,14 @@ def report(v: Validation) -> str:
                   "too badly while its closed-form lag is no more than 10 % shorter than FF + PVA's; **its 0 g flat "
                   "level** for a Chapter 6 cell out on the fresh seeds whose payload cost there matches the rig's "
                   f"within {EFFECT_SIGNIFICANCE:g} standard errors while its controller's 0 g flat cell is out the "
-                  "same way; **where the runs end scatters** (or **is off zero**) for an SSE range out on the fresh "
+                  "same way; **its payload's cost** for one out on the fresh seeds whose payload costs the twin "
+                  f"more (or less) than the rig by more than {EFFECT_SIGNIFICANCE:g} standard errors, the way it "
+                  "misses; **where the runs end scatters** (or **is off zero**) for an SSE range out on the fresh "
                   "seeds too, by whether the twin's signed steady errors centre within half a std of zero; "
                   "**follows** for an order that the measured values of its out cells would put right; else "
                   "**not shown by the twin**. A reading links a miss to another check; it is not a proof of its "
-                  "cause. The table and its rules were added on 2026-11-25, after every result they read.", "",
+                  "cause. The table and its rules were added on 2026-11-25, after every result they read; **its "
+                  "payload's cost** on 2026-11-26, after the one miss it reads.", "",
                   "| comparison | missed on | cell | measured | twin, seeds 0-4 | off by | fresh seeds | reading | "
                   "what the other checks show |", "|---|---|---|---|---|---|---|---|---|"]
         lines += [_miss_row(m) for m in missed]
