@@ -91,3 +91,21 @@ def test_trial_load_friction_edge_prints_what_prediction_md_quotes(capsys):
         "0.600": ("0.762 / 1.004 / 0.924 / 1.070", "+0.202 (+0.174 to +0.247)", "0.885", "0.000", "7.26 / 6.84"),
     }
     assert {key: tuple(row) for key, row in rows.items()} == expected
+
+
+@pytest.mark.slow  # about 65 s on 2 cores: two laws x two T1 cells x 40 seeds, nine variants
+def test_trial_payload_cost_effects_prints_what_as_built_md_quotes(capsys):
+    _load("trial_payload_cost_effects").main()
+    rows = {line.split(" | ")[0].strip(): line.split(" | ")[1:] for line in capsys.readouterr().out.splitlines()[1:]}
+    # effect switched off -> FF + PVA 0 g, 13.5 g, cost; sliding mode the same (T1 horizontal, seeds 40-79)
+    assert rows == {
+        "(nothing: as committed)": ["1.55, 1.56, x1.00 ± 0.02", "1.33, 1.60, x1.20 ± 0.03"],
+        "compressibility,supply_line": ["4.59, 9.51, x2.07 ± 0.02", "4.07, 7.32, x1.80 ± 0.02"],
+        "supply_line": ["1.59, 1.61, x1.01 ± 0.03", "1.37, 1.58, x1.15 ± 0.03"],
+        "stiction": ["1.54, 1.55, x1.01 ± 0.02", "1.30, 1.60, x1.24 ± 0.04"],
+        "ccw_friction": ["1.55, 1.57, x1.01 ± 0.03", "1.34, 1.56, x1.17 ± 0.03"],
+        "solenoid_valve": ["0.73, 0.93, x1.27 ± 0.02", "0.43, 0.60, x1.38 ± 0.02"],
+        "hall_calibration": ["1.19, 1.52, x1.27 ± 0.03", "1.31, 1.60, x1.22 ± 0.04"],
+        "experiment_gains": ["1.42, 1.45, x1.02 ± 0.02", "1.24, 1.63, x1.32 ± 0.05"],
+        "sensor_metrics": ["2.32, 2.24, x0.97 ± 0.02", "2.13, 2.18, x1.02 ± 0.02"],
+    }

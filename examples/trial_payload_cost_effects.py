@@ -1,0 +1,57 @@
+"""Trial (not installed): which as-built effect sets what a horizontal 13.5 g costs each law on T1.
+
+`twin validate` reads the sliding-mode T1 13.5 g horizontal miss by the payload's cost: on seeds 40-79 the
+payload costs the twin's sliding mode x1.20 over its 0 g flat cell, the rig's x1.03, while it costs the
+twin's FF + PVA x1.00, the rig's x1.25 (2026-11-26). This script runs both laws on T1 at 0 g and 13.5 g,
+horizontal, seeds 40-79, on the committed preset as it is and with each effect switched off in turn
+(compressibility only with the supply line, which needs it), nothing refitted, and prints each cell's mean
+RMSE and the cost (13.5 g over 0 g) with its standard error from the runs' spread. Its result (2026-11-26) is
+in docs/as-built.md.
+
+    python examples/trial_payload_cost_effects.py
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from twin.envs.runner import run_many
+from twin.physics.model import Orientation
+from twin.plants.as_built import as_built_plant
+from twin.sim.scenario import Scenario
+
+SEEDS = range(40, 80)
+VARIANTS = ((), ("compressibility", "supply_line"), ("supply_line",), ("stiction",), ("ccw_friction",),
+            ("solenoid_valve",), ("hall_calibration",), ("experiment_gains",), ("sensor_metrics",))
+CONTROLLERS = ("ffpva", "smc")
+PAYLOADS_G = (0.0, 13.5)
+
+
+def cost(flat: np.ndarray, loaded: np.ndarray) -> tuple[float, float]:
+    """The loaded cell's mean RMSE over the flat one's, and its standard error (normal approximation)."""
+    ratio = loaded.mean() / flat.mean()
+    return ratio, ratio * math.hypot(loaded.std(ddof=1) / math.sqrt(loaded.size) / loaded.mean(),
+                                     flat.std(ddof=1) / math.sqrt(flat.size) / flat.mean())
+
+
+def main() -> None:
+    print("without                          | FF + PVA 0 g, 13.5 g (deg), cost | sliding mode 0 g, 13.5 g (deg), cost "
+          "(T1 horizontal, seeds 40-79)")
+    for without in VARIANTS:
+        plant = as_built_plant(without=without, name="-".join(("as-built", *without)))
+        scenarios = [Scenario(c, 1, payload=g * 1e-3, orientation=Orientation.HORIZONTAL, plant=plant, seed=s)
+                     for c in CONTROLLERS for g in PAYLOADS_G for s in SEEDS]
+        results = run_many(scenarios)
+        n = len(SEEDS)
+        rmse = [np.array([math.degrees(r.metrics.rmse) for r in results[k * n:(k + 1) * n]]) for k in range(4)]
+        cells = []
+        for k in (0, 2):
+            ratio, se = cost(rmse[k], rmse[k + 1])
+            cells.append(f"{rmse[k].mean():.2f}, {rmse[k + 1].mean():.2f}, x{ratio:.2f} ± {se:.2f}")
+        print(f"{','.join(without) or '(nothing: as committed)':32s} | {cells[0]} | {cells[1]}", flush=True)
+
+
+if __name__ == "__main__":
+    main()
