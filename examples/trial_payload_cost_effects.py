@@ -5,7 +5,7 @@ payload costs the twin's sliding mode x1.20 over its 0 g flat cell, the rig's x1
 twin's FF + PVA x1.00, the rig's x1.25 (2026-11-26). This script runs both laws on T1 at 0 g and 13.5 g,
 horizontal, seeds 40-79, on the committed preset as it is and with each effect switched off in turn
 (compressibility only with the supply line, which needs it), nothing refitted, and prints each cell's mean
-RMSE and the cost (13.5 g over 0 g) with its standard error from the runs' spread. Its result (2026-11-26) is
+RMSE and the cost (13.5 g over 0 g) with its paired standard error. Its result (2026-11-26) is
 in docs/as-built.md.
 
     python examples/trial_payload_cost_effects.py
@@ -30,10 +30,11 @@ PAYLOADS_G = (0.0, 13.5)
 
 
 def cost(flat: np.ndarray, loaded: np.ndarray) -> tuple[float, float]:
-    """The loaded cell's mean RMSE over the flat one's, and its standard error (normal approximation)."""
+    """The loaded cell's mean RMSE over the flat one's, and its standard error. The two cells run on the same
+    seeds (the same stiction maps and noise), so the error is the paired one (delta method: the spread of
+    loaded - ratio * flat over the seeds), not that of two independent means."""
     ratio = loaded.mean() / flat.mean()
-    return ratio, ratio * math.hypot(loaded.std(ddof=1) / math.sqrt(loaded.size) / loaded.mean(),
-                                     flat.std(ddof=1) / math.sqrt(flat.size) / flat.mean())
+    return ratio, float(np.std(loaded - ratio * flat, ddof=1) / math.sqrt(flat.size) / flat.mean())
 
 
 def main() -> None:

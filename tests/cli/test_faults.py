@@ -825,35 +825,41 @@ def test_a_plotting_librarys_own_oserror_costs_only_the_figure_and_a_full_disk_s
 
 def test_a_stop_while_a_set_is_renamed_in_waits_until_the_whole_set_is_in(tmp_path, monkeypatch):
     """Ctrl-C and SIGTERM that come between two of staged()'s renames are held until the last one: the
-    folder gets the whole new set, then the stops are delivered in order to the handlers they had."""
+    folder gets the whole new set and loses the staging folder, then the stops are delivered in order to
+    the handlers they had, each even when an earlier one raised."""
     from twin.experiments.base import staged
 
     out = tmp_path / "out"
     out.mkdir()
-    for name in ("a.csv", "b.csv", "c.png"):
-        (out / name).write_text("old")
     rename = os.replace
-    signals = iter([signal.SIGTERM, signal.SIGINT, None])
-
-    def rename_then_stop(source, target):
-        rename(source, target)
-        signum = next(signals)
-        if signum is not None:
-            os.kill(os.getpid(), signum)
-            time.sleep(0.05)  # an unheld signal would be handled here, mid-set
-
     terms = []
-    before = signal.signal(signal.SIGTERM, lambda number, frame: terms.append(number))
+    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    signal.signal(signal.SIGINT, signal.default_int_handler)  # as in an interactive run, whatever started pytest
+    signal.signal(signal.SIGTERM, lambda number, frame: terms.append(number))
     try:
-        monkeypatch.setattr(os, "replace", rename_then_stop)
-        with pytest.raises(KeyboardInterrupt), staged(out, "t") as stage:
+        for order in ([signal.SIGTERM, signal.SIGINT], [signal.SIGINT, signal.SIGTERM]):
             for name in ("a.csv", "b.csv", "c.png"):
-                (stage.folder / name).write_text("new")
-                stage.names.append(name)
-        monkeypatch.undo()
-        assert {path.name: path.read_text() for path in out.iterdir()} == {"a.csv": "new", "b.csv": "new",
-                                                                           "c.png": "new"}
-        assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
-        assert terms == [signal.SIGTERM]  # delivered in the order they came, after the set was in
+                (out / name).write_text("old")
+            signals = iter([*order, None])
+
+            def rename_then_stop(source, target, signals=signals):
+                rename(source, target)
+                signum = next(signals)
+                if signum is not None:
+                    os.kill(os.getpid(), signum)
+                    time.sleep(0.05)  # an unheld signal would be handled here, mid-set
+
+            terms.clear()
+            monkeypatch.setattr(os, "replace", rename_then_stop)
+            with pytest.raises(KeyboardInterrupt), staged(out, "t") as stage:
+                for name in ("a.csv", "b.csv", "c.png"):
+                    (stage.folder / name).write_text("new")
+                    stage.names.append(name)
+            monkeypatch.undo()
+            assert {path.name: path.read_text() for path in out.iterdir()} == {"a.csv": "new", "b.csv": "new",
+                                                                               "c.png": "new"}
+            assert terms == [signal.SIGTERM]  # delivered after the set was in, whichever came first
+            assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     finally:
-        signal.signal(signal.SIGTERM, before)
+        for signum, handler in before.items():
+            signal.signal(signum, handler)

@@ -115,22 +115,27 @@ class Staging:
 
 @contextlib.contextmanager
 def staged(out: pathlib.Path, prefix: str):
-    """A set of outputs put into ``out`` all or nothing: written into a staging folder inside ``out``
-    (the :class:`Staging` yielded), then, once the block has written them all, each renamed into ``out``
-    (renames need no space) and an earlier run's copy of each figure left out removed (it must not pass for
-    this run's). If any write fails (a full disk, an interrupt), ``out`` keeps what it had. The staging
-    folder goes either way. A Ctrl-C or SIGTERM that comes while the set is being renamed in waits until
-    it is in (:func:`stops_held`), so it never mixes an old set with a new one."""
+    """A set of outputs put into ``out``: written into a staging folder inside ``out`` (the
+    :class:`Staging` yielded), then, once the block has written them all, each renamed into ``out`` (renames
+    need no space) and an earlier run's copy of each figure left out removed (it must not pass for this
+    run's). If the block fails (a full disk, an interrupt), ``out`` keeps what it had. A Ctrl-C or SIGTERM
+    that comes while the set is renamed in waits until it is in and the staging folder is gone
+    (:func:`stops_held`), so a stop never mixes an old set with a new one; a rename that itself fails (the
+    disk, not a stop) can. The staging folder goes either way."""
     stage = Staging(pathlib.Path(tempfile.mkdtemp(prefix=f".{prefix}-", dir=out)))
     try:
         yield stage
-        with stops_held():
+    except BaseException:
+        shutil.rmtree(stage.folder, ignore_errors=True)
+        raise
+    with stops_held():
+        try:
             for name in stage.names:
                 os.replace(stage.folder / name, out / name)
             for name, _ in stage.undrawn:
                 (out / name).unlink(missing_ok=True)
-    finally:
-        shutil.rmtree(stage.folder, ignore_errors=True)
+        finally:
+            shutil.rmtree(stage.folder, ignore_errors=True)
 
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
@@ -138,9 +143,10 @@ STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
 
 @contextlib.contextmanager
 def stops_held():
-    """Hold Ctrl-C and SIGTERM for the block and deliver them when it ends, once each in the order they
-    came, to the handlers they had: for a few renames that must all happen or none. Python runs signal handlers in the main
-    thread only, so outside it this holds nothing (no other thread can be stopped by one)."""
+    """Hold Ctrl-C and SIGTERM for the block, then put back the handlers they had and deliver each that
+    came, once, in the order they came (each even when an earlier one's handler raised): for a few
+    renames that must all happen or none. A handler set outside Python (``None``) comes back as the
+    default. Python runs signal handlers in the main thread only, so outside it this holds nothing."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -151,8 +157,16 @@ def stops_held():
     finally:
         for signum, handler in before.items():
             signal.signal(signum, signal.SIG_DFL if handler is None else handler)
-        for signum in dict.fromkeys(caught):
-            signal.raise_signal(signum)
+        _deliver(list(dict.fromkeys(caught)))
+
+
+def _deliver(signums: list[int]) -> None:
+    """Raise each signal in turn, the later ones even if an earlier one's handler raises."""
+    if signums:
+        try:
+            signal.raise_signal(signums[0])
+        finally:
+            _deliver(signums[1:])
 
 
 def tell_undrawn(undrawn: list[tuple[str, str]]) -> None:

@@ -1093,16 +1093,20 @@ def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[d
             f"controller's 0 g flat cell against x{cost['measured_effect']:.2f} ({cost['difference_in_se']:+.1f} "
             f"combined standard errors); that flat cell is x{flat['ratio']:.2f}"
             + (", within" if flat["within_tolerance"] else ", out")
-            + ("" if not (here and base) else _phase_cost(here, base))
+            + (_phase_cost(here, base) if here and base else "")
             + "; why the payload costs the twin's law differently, the twin does not show")
     return "open", "none of the other checks explains it"
 
 
 def _phase_cost(here: dict, base: dict) -> str:
-    """Where in T1 a cell's cost over its flat cell (:func:`payload_phases`' rows ``here`` and ``base``) falls."""
-    move, hold = here["move_deg"] / base["move_deg"], here["hold_deg"] / base["hold_deg"]
-    return (f". On seeds 0-4 the twin's cost falls in T1's {'move' if move > hold else 'hold'} (the flat cell's RMS "
-            f"error times x{move:.2f} over the move, x{hold:.2f} over the hold)")
+    """A cell's RMS error over T1's move and over its hold, each over its flat cell's (:func:`payload_phases`'
+    rows ``here`` and ``base``), or nothing where a ratio cannot be formed."""
+    ratios = [here[k] / base[k] if math.isfinite(here[k]) and base[k] > 0 else math.nan
+              for k in ("move_deg", "hold_deg")]
+    if not all(math.isfinite(x) for x in ratios):
+        return ""
+    return (f". On seeds 0-4 its RMS error is x{ratios[0]:.2f} the flat cell's over T1's move and x{ratios[1]:.2f} "
+            "over its hold")
 
 
 def _sse_reading(r: dict, f: dict | None, v: Validation) -> tuple[str, str]:
