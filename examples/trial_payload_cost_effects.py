@@ -17,16 +17,12 @@ import math
 
 import numpy as np
 
-from twin.envs.runner import run_many
-from twin.physics.model import Orientation
-from twin.plants.as_built import as_built_plant
-from twin.sim.scenario import Scenario
+from twin.experiments.calibrate import Evaluator
+from twin.experiments.studies.ablation import variants
+from twin.plants.as_built import calibrated_values
 
 SEEDS = range(40, 80)
-VARIANTS = ((), ("compressibility", "supply_line"), ("supply_line",), ("stiction",), ("ccw_friction",),
-            ("solenoid_valve",), ("hall_calibration",), ("experiment_gains",), ("sensor_metrics",))
-CONTROLLERS = ("ffpva", "smc")
-PAYLOADS_G = (0.0, 13.5)
+KEYS = [(c, 1, g, "horizontal") for c in ("ffpva", "smc") for g in (0.0, 13.5)]  # each law's 0 g, then 13.5 g
 
 
 def cost(flat: np.ndarray, loaded: np.ndarray) -> tuple[float, float]:
@@ -40,18 +36,17 @@ def cost(flat: np.ndarray, loaded: np.ndarray) -> tuple[float, float]:
 def main() -> None:
     print("without                          | FF + PVA 0 g, 13.5 g (deg), cost | sliding mode 0 g, 13.5 g (deg), cost "
           "(T1 horizontal, seeds 40-79)")
-    for without in VARIANTS:
-        plant = as_built_plant(without=without, name="-".join(("as-built", *without)))
-        scenarios = [Scenario(c, 1, payload=g * 1e-3, orientation=Orientation.HORIZONTAL, plant=plant, seed=s)
-                     for c in CONTROLLERS for g in PAYLOADS_G for s in SEEDS]
-        results = run_many(scenarios)
-        n = len(SEEDS)
-        rmse = [np.array([math.degrees(r.metrics.rmse) for r in results[k * n:(k + 1) * n]]) for k in range(4)]
-        cells = []
-        for k in (0, 2):
-            ratio, se = cost(rmse[k], rmse[k + 1])
-            cells.append(f"{rmse[k].mean():.2f}, {rmse[k + 1].mean():.2f}, x{ratio:.2f} ± {se:.2f}")
-        print(f"{','.join(without) or '(nothing: as committed)':32s} | {cells[0]} | {cells[1]}", flush=True)
+    values = calibrated_values()
+    with Evaluator(seeds=SEEDS, workers=2, cells=KEYS) as evaluator:
+        for _, off in variants():  # the ablation study's: the preset, then each effect off in turn
+            if "load_friction" in off:  # it acts only on a vertical joint: this row would be the preset's
+                continue
+            rmse = [np.array(cell.rmse_deg) for cell in evaluator.cells(values, without=off)]
+            cells = []
+            for k in (0, 2):
+                ratio, se = cost(rmse[k], rmse[k + 1])
+                cells.append(f"{rmse[k].mean():.2f}, {rmse[k + 1].mean():.2f}, x{ratio:.2f} ± {se:.2f}")
+            print(f"{','.join(off) or '(nothing: as committed)':32s} | {cells[0]} | {cells[1]}", flush=True)
 
 
 if __name__ == "__main__":

@@ -1041,8 +1041,7 @@ def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[d
     big = None if _loaded(r) else next((x for x in v.max_errors or [] if (x["controller"], x["trajectory"])
                                         == (r["controller"], r["trajectory"])), None)
     peak = None if big is None else big["fresh_mean"] if fresh_only else big["twin_mean"]
-    cost = next((x for x in v.effects if (x["controller"], x["payload_g"], x["orientation"])
-                 == (r["controller"], r["payload_g"], r["orientation"])), None)
+    cost = _cell_row(v.effects, r["controller"], r["payload_g"], r["orientation"])
     flat = next((x for x in v.seeds or [] if (x["controller"], x["trajectory"], x["payload_g"], x["orientation"])
                  == (r["controller"], 1, 0.0, "horizontal")), None)
     lag = (v.pulses or {}).get("lag_deg", {})
@@ -1084,9 +1083,8 @@ def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[d
                f"; on seeds 0-4 that flat cell is x{flat['five_run_mean'] / flat['measured']:.2f}"))
     if (cost and flat and f and _loaded(r) and abs(cost["difference_in_se"]) > EFFECT_SIGNIFICANCE
             and (cost["difference_in_se"] > 0) == high(f) == high(miss)):
-        phase = {(x["controller"], x["payload_g"], x["orientation"]): x for x in v.phases or []}
-        here = phase.get((r["controller"], r["payload_g"], r["orientation"]))
-        base = phase.get((r["controller"], 0.0, "horizontal"))
+        here = _cell_row(v.phases, r["controller"], r["payload_g"], r["orientation"])
+        base = _cell_row(v.phases, r["controller"], 0.0, "horizontal")
         return "payload cost", (
             f"on seeds {flat['seeds']}, where this cell is x{f['ratio']:.2f}, the payload costs the twin "
             + ("more" if high(miss) else "less") + f" than it cost the rig: x{cost['twin_effect']:.2f} over its "
@@ -1096,6 +1094,12 @@ def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[d
             + (_phase_cost(here, base) if here and base else "")
             + "; why the payload costs the twin's law differently, the twin does not show")
     return "open", "none of the other checks explains it"
+
+
+def _cell_row(rows: Sequence[dict] | None, controller: str, payload_g: float, orientation: str) -> dict | None:
+    """The row of ``rows`` (a T1 table: :func:`payload_effects`, :func:`payload_phases`) for that cell, if any."""
+    return next((x for x in rows or [] if (x["controller"], x["payload_g"], x["orientation"])
+                 == (controller, payload_g, orientation)), None)
 
 
 def _phase_cost(here: dict, base: dict) -> str:
@@ -1117,8 +1121,7 @@ def _sse_reading(r: dict, f: dict | None, v: Validation) -> tuple[str, str]:
                         f"{f['sse_groups_within']} of {f['groups']} groups within")
     if not judged or f.get("sse_std") is None:
         return "open", "none of the other checks explains it"
-    cost = next((x for x in v.effects if (x["controller"], x["payload_g"], x["orientation"])
-                 == (r["controller"], r["payload_g"], r["orientation"])), None)
+    cost = _cell_row(v.effects, r["controller"], r["payload_g"], r["orientation"])
     centred = abs(f["sse_mean"]) < f["sse_std"] / 2
     return ("scatter" if centred else "offset"), (
         f"out on seeds {f['seeds']}" + (" too" if not r["within_tolerance"] else "") + ", "
