@@ -109,3 +109,22 @@ def test_trial_payload_cost_effects_prints_what_as_built_md_quotes(capsys):
         "experiment_gains": ["1.42, 1.45, x1.02 ± 0.02", "1.24, 1.63, x1.32 ± 0.05"],
         "sensor_metrics": ["2.32, 2.24, x0.97 ± 0.02", "2.13, 2.18, x1.02 ± 0.02"],
     }
+
+
+@pytest.mark.slow  # about 20 s on 2 cores: three laws on T1 from six start angles, ten seeds each
+def test_trial_t1_start_prints_what_as_built_md_quotes(capsys):
+    from twin.physics import trajectories
+
+    committed = trajectories.START
+    _load("trial_t1_start").main()
+    assert trajectories.START == committed  # the trial puts the committed start back
+    rows = {tuple(line.split()[1:4:2]): line.split("  ")[-1].strip()
+            for line in capsys.readouterr().out.splitlines() if line.startswith("start")}
+    # (start in deg, law) -> RMSE mean ± std, largest error, move / hold RMS, SSE ranges (deg)
+    pva = {start: rows[(start, "pva")] for start in ("10", "20", "30", "40", "50", "54")}
+    assert [row.split(",")[0] for row in pva.values()] == ["1.82 ± 0.13", "1.86 ± 0.18", "1.66 ± 0.10", "1.89 ± 0.19",
+                                                          "1.97 ± 0.25", "1.87 ± 0.27"]
+    assert [row.split(",")[1] for row in pva.values()] == [" largest 7.8", " largest 7.6", " largest 7.7",
+                                                          " largest 7.8", " largest 8.3", " largest 8.5"]
+    assert [rows[(s, "ffpva")].split(",")[0] for s in ("30", "54")] == ["1.60 ± 0.15", "1.21 ± 0.08"]
+    assert [rows[(s, "smc")].split(",")[0] for s in ("30", "20", "54")] == ["1.34 ± 0.09", "1.41 ± 0.25", "1.48 ± 0.33"]
