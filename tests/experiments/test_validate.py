@@ -60,7 +60,7 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
     for r in predicted:
         assert float(r["band_p10"]) <= float(r["band_p50"]) <= float(r["band_p90"])
         assert int(r["stalled_runs"]) >= 0 and math.isfinite(float(r["twin_mean"]))
-    report = (out / "validation.md").read_text()
+    report = (out / "validation.md").read_text(encoding="utf-8")
     assert "## Why, as far as the twin shows" in report and "## Prediction: Chapter 6 T3 (blind)" in report
     assert "![T2's first run" in report
     columns, more = rows_of(out / "seeds.csv")
@@ -82,6 +82,32 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
         assert (out / name).read_bytes().startswith(b"\x89PNG")
     assert not list(out.glob("*.tmp*"))
     assert "wrote" in proc.stdout and "prediction.csv" in proc.stdout
+    # The committed docs/validation.md is this report under a two-line header: a change to the code or the preset
+    # that moves any number in it fails here until the page is written anew.
+    committed = (ROOT / "docs" / "validation.md").read_text(encoding="utf-8").split("\n", 2)[2]
+    stale = next((f"line {i + 3}: committed {a!r}, now {b!r}" for i, (a, b) in
+                  enumerate(zip(committed.splitlines(), report.splitlines(), strict=False)) if a != b), None)
+    assert committed == report, f"docs/validation.md is stale ({stale or 'its length differs'}); re-run twin validate"
+    # The README's results table is validation.csv's Chapter 5 experiment rows, and docs/prediction.md's current
+    # table prediction.csv's rows, to the two places they print.
+    readme = _rows((ROOT / "README.md").read_text(encoding="utf-8"))
+    assert {(c[0], c[1]): c[3:] for c in readme} == {
+        (r["controller"], r["trajectory"]): [f"{float(r['twin_mean']):.2f} ± {float(r['twin_std']):.2f}",
+                                             f"{float(r['ratio']):.2f}"]
+        for r in rows if r["source"] == "chapter 5 experiment"}, "the README's results table is stale"
+    current = (ROOT / "docs" / "prediction.md").read_text(encoding="utf-8").split("\n## ")[1]  # its first section
+    assert {(c[0], c[1], c[2]): c[3:7] + c[8:] for c in _rows(current)} == {
+        (r["controller"], f"{float(r['payload_g']):g} g", r["orientation"]): [
+            *(f"{float(r[k]):.2f}" for k in ("twin_mean", "band_p10", "band_p50", "band_p90")), r["stalled_runs"]]
+        for r in predicted}, "docs/prediction.md's current table is stale"
+
+
+def _rows(text: str) -> list[list[str]]:
+    """The cells of each markdown table row that starts with a controller's name, the name as its id."""
+    names = {"PVA + DZC": "pva", "FF + PVA": "ffpva", "sliding mode": "smc"}
+    cells = ([c.strip() for c in line.strip().strip("|").split("|")] for line in text.splitlines()
+             if line.startswith("|"))
+    return [[names[c[0]], *c[1:]] for c in cells if c[0] in names]
 
 
 def test_validate_without_a_calibration_is_a_one_line_error_and_writes_nothing(tmp_path, monkeypatch, capsys):

@@ -40,6 +40,7 @@ assumptions, stated in :data:`ASSUMED`.
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import importlib.resources
 import json
 import pathlib
@@ -227,6 +228,15 @@ def ensemble_plants(path: pathlib.Path = CALIBRATION_FILE) -> list:
     return [as_built_plant(values, name=f"as-built~{k}") for k, values in enumerate(ensemble_values(path))]
 
 
+def preset_digest(path: pathlib.Path = CALIBRATION_FILE) -> str:
+    """12 hex digits naming the as-built plant and its ensemble as they load from ``path``: every one of
+    their parameters, fitted, assumed or the thesis's (a change to the code that moves no parameter leaves
+    it alone). The pages in docs/ that quote numbers measured on the committed preset carry it, and a test
+    holds them to it (tests/test_docs.py)."""
+    plants = (as_built_plant(calibrated_values(path)), ensemble_plants(path))
+    return hashlib.sha256(repr(plants).encode()).hexdigest()[:12]
+
+
 __all__ = ["ASSUMED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "FITTED",
            "FULL_DUTY_SPEED_DIGIT", "FULL_DUTY_WINDOW", "SLOWEST_FULL_DUTY_SPEED", "STICTION_SCATTER",
-           "as_built_params", "as_built_plant", "calibrated_values", "ensemble_plants", "ensemble_values"]
+           "as_built_params", "as_built_plant", "calibrated_values", "ensemble_plants", "ensemble_values", "preset_digest"]

@@ -1,0 +1,43 @@
+"""The docs pages that quote numbers run on the committed as-built preset name the preset they were run on.
+
+A refit, a valve refit or a changed assumption changes :func:`twin.plants.as_built.preset_digest`; this test
+then fails until each page below has been brought up to the new preset and its stamp changed. The stamp is a
+promise, not a proof: the slow test of ``twin validate`` checks docs/validation.md, the README's results
+table and docs/prediction.md's current table against a fresh run, number for number; the other numbers of
+these pages only the person who re-runs them can check.
+"""
+
+from __future__ import annotations
+
+import json
+import pathlib
+import re
+
+from twin.plants import as_built
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+STAMPED = ("docs/as-built.md", "docs/prediction.md", "docs/studies-and-whatifs.md")
+STAMP = re.compile(r"<!-- as-built preset ([0-9a-f]{12}): ")
+
+
+def test_each_page_that_quotes_the_committed_preset_names_it():
+    digest = as_built.preset_digest()
+    for page in STAMPED:
+        found = STAMP.findall((ROOT / page).read_text(encoding="utf-8"))
+        assert found == [digest], (f"{page} says it was run on as-built preset {found or 'none'}, the committed one is "
+                                   f"{digest}: re-run what it quotes, then change its stamp")
+
+
+def test_the_digest_follows_every_value_of_the_calibration_and_nothing_else(tmp_path):
+    record = json.loads(as_built.CALIBRATION_FILE.read_text())
+    same = tmp_path / "same.json"
+    same.write_text(json.dumps({**record, "wall_time_s": 1.0, "made_by": "someone else"}))
+    assert as_built.preset_digest(same) == as_built.preset_digest()
+    name = next(iter(record["fitted"]))
+    for where in ("fitted", "ensemble"):
+        moved = json.loads(json.dumps(record))
+        values = moved["fitted"] if where == "fitted" else moved["ensemble"][-1]["values"]
+        values[name] *= 1.001
+        path = tmp_path / f"{where}.json"
+        path.write_text(json.dumps(moved))
+        assert as_built.preset_digest(path) != as_built.preset_digest(), where
