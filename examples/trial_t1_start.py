@@ -23,17 +23,29 @@ import math
 import numpy as np
 
 from twin.envs.runner import run_many
+from twin.experiments.reference import (
+    THESIS_EXPERIMENT_MAX_ERROR_DEG,
+    THESIS_EXPERIMENT_RMSE_DEG,
+    THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
+)
 from twin.physics import trajectories
 from twin.sim.scenario import Scenario
 
 SEEDS = range(10)
 START_DEG = (10.0, 20.0, 30.0, 40.0, 50.0, 54.0)  # deg; 30 is the committed start
 LAWS = ("pva", "ffpva", "smc")
-RIG = {"pva": "4.20 ± 0.76, largest 13.5, SSE ±0.41", "ffpva": "1.40 ± 0.06, largest 5, SSE ±0.77",
-       "smc": "1.19 ± 0.11, largest 5, SSE ±0.85"}  # SPEC §8, horizontal, no payload
+
+
+def rig(law: str) -> str:
+    """§8's T1 cell of ``law`` (horizontal, no payload), as the rows below print theirs."""
+    mean, std = THESIS_EXPERIMENT_RMSE_DEG[law][1]
+    return (f"{mean:.2f} ± {std:.2f}, largest {THESIS_EXPERIMENT_MAX_ERROR_DEG[law][1]:g}, "
+            f"SSE ±{THESIS_EXPERIMENT_SSE_T1_RANGE_DEG[law]:.2f}")
 
 
 def row(law: str) -> str:
+    """``law`` on T1 from the start in force, seeds :data:`SEEDS`: RMSE mean ± std, the largest error's mean,
+    the RMS error over the move (0-1 s) and over the hold, the SSE ranges of each five seeds (deg)."""
     runs = run_many([Scenario(law, 1, plant="as-built", seed=s) for s in SEEDS])
     rmse = np.array([math.degrees(r.metrics.rmse) for r in runs])
     largest = float(np.mean([math.degrees(r.metrics.max_error) for r in runs]))
@@ -50,7 +62,7 @@ def main() -> None:
     print("T1 on the committed as-built preset, seeds 0-9: RMSE mean ± std, largest error (mean), RMS over the "
           "move / the hold, SSE ranges of seeds 0-4 / 5-9 (deg)")
     for law in LAWS:
-        print(f"{law}: the rig {RIG[law]}")
+        print(f"{law}: the rig {rig(law)}")
     committed = trajectories.START
     try:
         for start in START_DEG:

@@ -1,7 +1,8 @@
 """The docs pages that quote numbers run on the committed as-built preset name the preset they were run on.
 
-A refit, a valve refit or a changed assumption changes :func:`twin.plants.as_built.preset_digest`; this test
-then fails until each page below has been brought up to the new preset and its stamp changed. The stamp is a
+A refit, a valve refit or a changed assumption about the plant changes
+:func:`twin.plants.as_built.preset_digest` (every parameter of the as-built plant and its ensemble; not the
+controllers' gains, the trajectories or the code, which it does not see); this test then fails until each page below has been brought up to the new preset and its stamp changed. The stamp is a
 promise, not a proof: the slow test of ``twin validate`` checks docs/validation.md, the README's results
 table and docs/prediction.md's current table against a fresh run, number for number; the other numbers of
 these pages only the person who re-runs them can check.
@@ -16,7 +17,7 @@ import re
 from twin.plants import as_built
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-STAMPED = ("docs/as-built.md", "docs/prediction.md", "docs/studies-and-whatifs.md")
+STAMPED = ("README.md", "docs/as-built.md", "docs/prediction.md", "docs/studies-and-whatifs.md")
 STAMP = re.compile(r"<!-- as-built preset ([0-9a-f]{12}): ")
 
 
@@ -29,15 +30,16 @@ def test_each_page_that_quotes_the_committed_preset_names_it():
 
 
 def test_the_digest_follows_every_value_of_the_calibration_and_nothing_else(tmp_path):
-    record = json.loads(as_built.CALIBRATION_FILE.read_text())
+    record = json.loads(as_built.CALIBRATION_FILE.read_text(encoding="utf-8"))
     same = tmp_path / "same.json"
-    same.write_text(json.dumps({**record, "wall_time_s": 1.0, "made_by": "someone else"}))
-    assert as_built.preset_digest(same) == as_built.preset_digest()
-    name = next(iter(record["fitted"]))
-    for where in ("fitted", "ensemble"):
-        moved = json.loads(json.dumps(record))
-        values = moved["fitted"] if where == "fitted" else moved["ensemble"][-1]["values"]
-        values[name] *= 1.001
-        path = tmp_path / f"{where}.json"
-        path.write_text(json.dumps(moved))
-        assert as_built.preset_digest(path) != as_built.preset_digest(), where
+    same.write_text(json.dumps({**record, "wall_time_s": 1.0, "made_by": "someone else"}), encoding="utf-8")
+    committed = as_built.preset_digest()
+    assert as_built.preset_digest(same) == committed
+    for name in record["fitted"]:
+        for where in ("fitted", "ensemble"):
+            moved = json.loads(json.dumps(record))
+            values = moved["fitted"] if where == "fitted" else moved["ensemble"][-1]["values"]
+            values[name] *= 1.001
+            path = tmp_path / f"{where}-{name}.json"
+            path.write_text(json.dumps(moved), encoding="utf-8")
+            assert as_built.preset_digest(path) != committed, (where, name)

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import importlib.util
 import pathlib
+import re
 
 import pytest
 
@@ -118,16 +119,29 @@ def test_trial_t1_start_prints_what_as_built_md_quotes(capsys):
     committed = trajectories.START
     _load("trial_t1_start").main()
     assert trajectories.START == committed  # the trial puts the committed start back
-    rows = {tuple(line.split()[1:4:2]): line.split("  ")[-1].strip()
-            for line in capsys.readouterr().out.splitlines() if line.startswith("start")}
-    # (start in deg, law) -> RMSE mean ± std, largest error, move / hold RMS, SSE ranges (deg)
-    pva = {start: rows[(start, "pva")] for start in ("10", "20", "30", "40", "50", "54")}
-    assert [row.split(",")[0] for row in pva.values()] == ["1.82 ± 0.13", "1.86 ± 0.18", "1.66 ± 0.10", "1.89 ± 0.19",
-                                                          "1.97 ± 0.25", "1.87 ± 0.27"]
-    assert [row.split(",")[1] for row in pva.values()] == [" largest 7.8", " largest 7.6", " largest 7.7",
-                                                          " largest 7.8", " largest 8.3", " largest 8.5"]
-    assert [rows[(s, "ffpva")].split(",")[0] for s in ("30", "54")] == ["1.60 ± 0.15", "1.21 ± 0.08"]
-    assert [rows[(s, "smc")].split(",")[0] for s in ("30", "20", "54")] == ["1.34 ± 0.09", "1.41 ± 0.25", "1.48 ± 0.33"]
+    rows = {m.group(1, 2): m.group(3) for m in (re.fullmatch(r"start +(\d+) deg +(\w+) +(.*)", line)
+                                                for line in capsys.readouterr().out.splitlines()) if m}
+    # (start in deg, law) -> RMSE mean ± std, largest error (mean), move / hold RMS, SSE ranges of seeds 0-4 / 5-9
+    assert rows == {
+        ("10", "pva"): "1.82 ± 0.13, largest 7.8, move 2.93 hold 0.82, SSE ±0.80 / ±1.28",
+        ("10", "ffpva"): "1.58 ± 0.31, largest 5.7, move 2.21 hold 1.19, SSE ±0.73 / ±0.79",
+        ("10", "smc"): "1.39 ± 0.20, largest 5.8, move 2.20 hold 0.72, SSE ±0.36 / ±0.50",
+        ("20", "pva"): "1.86 ± 0.18, largest 7.6, move 2.93 hold 0.96, SSE ±1.44 / ±1.40",
+        ("20", "ffpva"): "1.39 ± 0.16, largest 5.7, move 2.04 hold 0.92, SSE ±1.20 / ±1.14",
+        ("20", "smc"): "1.41 ± 0.25, largest 5.9, move 2.12 hold 0.90, SSE ±0.99 / ±0.99",
+        ("30", "pva"): "1.66 ± 0.10, largest 7.7, move 2.82 hold 0.42, SSE ±0.21 / ±0.71",
+        ("30", "ffpva"): "1.60 ± 0.15, largest 6.0, move 2.18 hold 1.23, SSE ±0.27 / ±1.17",
+        ("30", "smc"): "1.34 ± 0.09, largest 5.6, move 2.14 hold 0.63, SSE ±0.59 / ±0.63",
+        ("40", "pva"): "1.89 ± 0.19, largest 7.8, move 3.00 hold 0.94, SSE ±0.85 / ±0.32",
+        ("40", "ffpva"): "1.44 ± 0.21, largest 5.7, move 2.14 hold 0.94, SSE ±1.18 / ±0.38",
+        ("40", "smc"): "1.35 ± 0.14, largest 5.5, move 2.17 hold 0.62, SSE ±0.68 / ±0.88",
+        ("50", "pva"): "1.97 ± 0.25, largest 8.3, move 3.08 hold 1.07, SSE ±0.66 / ±0.22",
+        ("50", "ffpva"): "1.25 ± 0.07, largest 5.8, move 2.10 hold 0.41, SSE ±0.33 / ±1.65",
+        ("50", "smc"): "1.47 ± 0.28, largest 5.5, move 2.21 hold 0.96, SSE ±0.59 / ±0.32",
+        ("54", "pva"): "1.87 ± 0.27, largest 8.5, move 3.04 hold 0.85, SSE ±0.42 / ±0.28",
+        ("54", "ffpva"): "1.21 ± 0.08, largest 5.8, move 1.97 hold 0.50, SSE ±0.64 / ±0.90",
+        ("54", "smc"): "1.48 ± 0.33, largest 5.8, move 2.24 hold 0.97, SSE ±0.56 / ±0.31",
+    }
 
 
 @pytest.mark.slow  # about 9 min on 2 cores: 21 cells x 40 seeds and T3's 12 cells x 5 seeds, 14 chamber variants

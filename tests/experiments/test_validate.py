@@ -95,7 +95,8 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
         (r["controller"], r["trajectory"]): [f"{float(r['twin_mean']):.2f} ± {float(r['twin_std']):.2f}",
                                              f"{float(r['ratio']):.2f}"]
         for r in rows if r["source"] == "chapter 5 experiment"}, "the README's results table is stale"
-    current = (ROOT / "docs" / "prediction.md").read_text(encoding="utf-8").split("\n## ")[1]  # its first section
+    current = next(part for part in (ROOT / "docs" / "prediction.md").read_text(encoding="utf-8").split("\n## ")
+                   if part.split("\n", 1)[0].endswith(", current)"))  # the section headed "... current)"
     assert {(c[0], c[1], c[2]): c[3:7] + c[8:] for c in _rows(current)} == {
         (r["controller"], f"{float(r['payload_g']):g} g", r["orientation"]): [
             *(f"{float(r[k]):.2f}" for k in ("twin_mean", "band_p10", "band_p50", "band_p90")), r["stalled_runs"]]

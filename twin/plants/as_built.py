@@ -230,9 +230,9 @@ def ensemble_plants(path: pathlib.Path = CALIBRATION_FILE) -> list:
 
 def preset_digest(path: pathlib.Path = CALIBRATION_FILE) -> str:
     """12 hex digits naming the as-built plant and its ensemble as they load from ``path``: every one of
-    their parameters, fitted, assumed or the thesis's (a change to the code that moves no parameter leaves
-    it alone). The pages in docs/ that quote numbers measured on the committed preset carry it, and a test
-    holds them to it (tests/test_docs.py)."""
+    their parameters, fitted, assumed or the thesis's. It does not see the controllers' gains (the plant
+    names only its gain set), the trajectories or the code. The README and the pages in docs/ that quote
+    numbers run on the committed preset carry it, and a test holds them to it (tests/test_docs.py)."""
     plants = (as_built_plant(calibrated_values(path)), ensemble_plants(path))
     return hashlib.sha256(repr(plants).encode()).hexdigest()[:12]
 
