@@ -29,8 +29,6 @@ cells, which the README sums up); a slow test in tests/experiments/test_trials.p
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 
 from twin.experiments import calibrate
@@ -44,13 +42,6 @@ LEAK = (0.0, 3e-14, 6e-14, 1.2e-13)  # m^3/(Pa s) past each discharge valve; the
 SEED_SETS = (calibrate.FIT_SEEDS, *calibrate.NOISE_SEED_SETS)
 T3 = [(c, 3, g, o) for c in ("ffpva", "smc") for o in ("horizontal", "vertical") for g in THESIS_PAYLOADS_G]
 SHOWN = (("smc", 2), ("smc", 3), ("ffpva", 1))  # printed after PVA T1: (controller, trajectory), 0 g flat
-
-
-def mean_lag(values: dict[str, float]) -> float:
-    """s, the mean lag at the open-loop test's reversals (`twin validate`'s measure)."""
-    run = openloop_run(as_built_plant(values, name="as-built-trial"))
-    lags = [r.lag for r in run.reversals if not math.isnan(r.lag)]
-    return float(np.mean(lags)) if lags else math.nan
 
 
 def main() -> None:
@@ -76,8 +67,9 @@ def main() -> None:
             shown = (f"{pva.mean_rmse:.2f} ({np.mean(pva.max_error_deg):.1f}), "
                      + ", ".join(f"{by_key[k].mean_rmse:.2f}" for k in SHOWN))
             t3 = [f"{c.mean_rmse:.2f}" for c in evaluator.cells(values, keys=T3, seeds=range(5))]
+            lag = openloop_run(as_built_plant(values, name="as-built-trial")).mean_lag  # s
             print(f"{name:>12} | {' / '.join(f'{c:.3f}' for c in costs[name])} | {diff.mean():+.3f} "
-                  f"({diff.min():+.3f} to {diff.max():+.3f}) | {within} | {shown} | {mean_lag(values) * 1e3:.0f} | "
+                  f"({diff.min():+.3f} to {diff.max():+.3f}) | {within} | {shown} | {lag * 1e3:.0f} | "
                   f"{' / '.join(t3[:6])}; {' / '.join(t3[6:])}", flush=True)
 
 

@@ -53,6 +53,12 @@ class OpenLoopRun:
     reversals: tuple[Reversal, ...]
     warnings: tuple[str, ...]
 
+    @property
+    def mean_lag(self) -> float:
+        """s, the mean lag over the reversals the joint followed (nan where it followed none)."""
+        lags = [r.lag for r in self.reversals if not math.isnan(r.lag)]
+        return float(np.mean(lags)) if lags else math.nan
+
 
 @dataclasses.dataclass(frozen=True)
 class OpenLoopStudy:
