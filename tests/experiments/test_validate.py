@@ -179,7 +179,7 @@ def test_report_judges_the_dependence_on_every_member_not_the_band_alone():
 
 def test_report_names_every_parameter_the_members_differ_in_and_only_those_that_set_two_apart():
     """The spans list each profiled parameter (one value said as such) and any other the members differ in
-    (here the leak, which a simplex step moved), not one they share (the air); the widest cell's two members
+    (here the leak, which a simplex step moved), not one they share (the air, said apart); the widest cell's two members
     are told apart by what differs between them alone."""
     base = {"stiction": 1.09, "air_fraction": 0.0283, "ccw_coulomb_scale": 1.16, "leak_conductance": 1.39e-14,
             "load_friction": 0.29, "observer_gain": 340.0}
@@ -190,7 +190,9 @@ def test_report_names_every_parameter_the_members_differ_in_and_only_those_that_
     assert ("from the member with load friction 0.29 N/N and leak 1.39 x 1e-14 m^3/(Pa s) to the one with load "
             "friction 0.38 N/N and leak 1.16 x 1e-14 m^3/(Pa s)") in text
     assert "CCW Coulomb scale: 1.16, 1.27, 1.16; leak (x 1e-14 m^3/(Pa s)): 1.39, 1.39, 1.16." in text
-    assert "air" not in text.split("The members, in order:")[1].split("|")[0]
+    listing = text.split("The members, in order:")[1].split(" Every member has")[0]
+    assert "air" not in listing and "CCW Coulomb scale: 1.16, 1.27, 1.16" in listing
+    assert "Every member has the same air 2.83 %: the fit does not profile it" in text  # said apart, once
 
 
 def test_report_shows_what_sliding_modes_switching_term_does():
@@ -881,3 +883,18 @@ def test_a_member_without_a_mean_is_not_counted_out_or_in():
     v.prediction_detail["fitted_means"] = [{pva2: math.nan}, {pva2: 2.2}]
     line = next(x for x in validate._why_members(v))
     assert "Out on every member" not in line  # one member has no mean: not known to be out there
+
+
+def test_prediction_names_the_fitted_values_no_member_varies():
+    """A fitted value every member shares and the fit does not profile is named, with its unit; the air also
+    points to the what-if that moves it; a value that differs between members, or a profiled one, is not."""
+    member = {"stiction": 1.09, "air_fraction": 0.0283, "ccw_coulomb_scale": 1.16, "leak_conductance": 1.39e-14,
+              "load_friction": 0.29, "observer_gain": 340.0}
+    members = [member, dict(member, leak_conductance=1.5e-14)]
+    text = validate._fixed_text(members)
+    assert text.startswith("Every member has the same air 2.83 %: the fit does not profile it, so the band does "
+                           "not show what it does. `twin whatif air` runs these cells")
+    assert "breakaway" not in text and "leak" not in text  # profiled (shared or not), and varied
+    both = validate._fixed_text([member, dict(member)])
+    assert "air 2.83 % and leak 1.39 x 1e-14 m^3/(Pa s): the fit does not profile them" in both  # neither varied
+    assert validate._fixed_text([member, dict(member, air_fraction=0.03, leak_conductance=1.5e-14)]) == ""

@@ -153,7 +153,8 @@ def test_whatif_lift_cli_writes_sorted_rows_and_says_what_it_did_not_study(tmp_p
 @pytest.mark.parametrize("study, flag, value", [
     ("lift", "--pressures", "100,x"), ("lift", "--pressures", "900"), ("payload", "--payloads", "0,x"),
     ("payload", "--payloads", "-5"), ("pwm", "--periods", "2.5"), ("smc-phi", "--phis", "0"),
-    ("smc-phi", "--phis", "0.2,x"), ("smc-phi", "--plant", "thesis")])
+    ("smc-phi", "--phis", "0.2,x"), ("smc-phi", "--plant", "thesis"), ("air", "--air", "25"), ("air", "--air", "2,,3"),
+    ("air", "--air", "-1"), ("air", "--air", ",".join(str(k / 10) for k in range(51)))])
 def test_whatif_rejects_a_bad_list_naming_its_flag_and_writes_nothing(tmp_path, capsys, study, flag, value):
     out = tmp_path / "never"
     assert main(["whatif", study, flag, value, "--out", str(out)]) == 2
@@ -269,3 +270,77 @@ def test_whatif_smc_phi_cli_writes_its_table_and_plot(tmp_path):
     assert [(r["controller"], r["phi_m_s"]) for r in rows] == [("smc", "0.3")] * 9 + [("ffpva", "")] * 9
     assert (out / "smc-phi.png").read_bytes().startswith(b"\x89PNG")
     assert "A what-if, not a fit" in (out / "smc-phi.txt").read_text()
+
+
+def _air_rows(air_pct: float, cost: float, rmse: dict, *, committed: bool = False, inside: bool = True,
+              line: float = 0.7, std: float = 0.1) -> list[dict]:
+    """Made-up ``twin whatif air`` rows for one air value: ``rmse`` {(controller, payload g, orientation): deg}."""
+    from twin.experiments.whatifs.air import COLUMNS
+
+    return [dict(zip(COLUMNS, (air_pct, committed, inside, cost, line, cost <= line, c, 3, g, o, value, std),
+                     strict=True)) for (c, g, o), value in rmse.items()]
+
+
+def _t3(ffpva: list[float], smc: list[float]) -> dict:
+    cells = [(g, o) for o in ("horizontal", "vertical") for g in (0.0, 6.5, 13.5)]
+    return {**{("ffpva", *cell): x for cell, x in zip(cells, ffpva, strict=True)},
+            **{("smc", *cell): x for cell, x in zip(cells, smc, strict=True)}}
+
+
+def test_air_answer_reads_the_line_and_which_law_leads():
+    """Made-up rows: each value's cost against the line, who leads in how many cells and by how much (two
+    standard errors: 0.1 deg std over 5 runs each gives 2 x 0.063); the verdict reads the values under the
+    line only."""
+    from twin.experiments.whatifs.air import answer
+
+    ffpva_ahead = _t3([2.0] * 6, [2.2, 2.2, 2.2, 2.2, 2.2, 1.95])  # FF + PVA by 0.2 in 5, sliding mode by 0.05 in 1
+    smc_ahead = _t3([2.3] * 6, [2.0] * 6)
+    rows = (_air_rows(2.0, 0.65, ffpva_ahead) + _air_rows(2.83, 0.56, ffpva_ahead, committed=True)
+            + _air_rows(5.0, 0.66, smc_ahead, inside=False) + _air_rows(8.0, 0.95, smc_ahead, inside=False))
+    text = answer(rows, seeds=5, best=0.56, noise=0.14, box_pct=(0.0, 3.0))
+    assert "ensemble line 0.700 (best 0.560 + seed-to-seed noise 0.140); T3 RMSE in deg over seeds 0-4" in text
+    assert ("air 2 % (inside the box): cost 0.650, under the line; FF + PVA leads in 5 of 6 (by 0.20 deg, 5 by more "
+            "than two standard errors); sliding mode leads in 1 of 6 (by 0.05 deg, 0 by more than two standard "
+            "errors). 0 g H 2.00 / 2.20") in text
+    assert "air 2.83 % (the committed value): cost 0.560, under the line" in text
+    assert ("air 8 % (outside the box): cost 0.950, over the line; sliding mode leads in 6 of 6 (by 0.30 deg, 6 by "
+            "more than two standard errors)") in text
+    assert ("Under the line, the law ahead in most T3 cells is FF + PVA at 2, 2.83 %, sliding mode at 5 %: which law "
+            "leads on T3 turns on the air") in text
+    assert "on its own 10 seeds; on other seed sets a cost moves by about the noise (0.140)" in text
+    same = [r for r in rows if r["air_pct"] != 5.0]
+    assert ("Under the line, FF + PVA at 2, 2.83 % leads in most T3 cells: which law leads does not turn on the air"
+            in answer(same, seeds=5, best=0.56, noise=0.14, box_pct=(0.0, 3.0)))
+    over = [dict(r, under_line=False) for r in rows]
+    assert "No air value run is under the line" in answer(over, seeds=5, best=0.56, noise=0.14, box_pct=(0.0, 3.0))
+    one = answer(_air_rows(3.0, 0.6, ffpva_ahead, std=0.0), seeds=1, best=0.56, noise=0.14, box_pct=(0.0, 3.0))
+    assert "over seed 0," in one and "(by 0.20 deg);" in one and "standard errors" not in one
+
+
+@pytest.mark.slow  # about 30 s on 2 cores: the fit's 21 cells x 10 seeds at two air values
+def test_whatif_air_scores_as_the_fit_does_and_moves_the_air_alone(tmp_path):
+    """At the committed air the what-if's cost is the calibration file's own, to the CSV's twelve digits (the
+    same cells, seeds and loss as the fit); its T3 cells are plain runs of the as-built plant with the air set
+    and nothing else changed."""
+    from twin.envs.runner import run_many
+    from twin.experiments.validate import PREDICTION_CELLS
+    from twin.experiments.whatifs.ensemble import cell_scenario
+    from twin.plants.as_built import as_built_plant, calibrated_values, calibration_cost_line
+
+    rows = _whatif_rows(tmp_path / "air", "air", "--air", "4", "--seeds", "2")
+    committed = calibrated_values()
+    best, noise = calibration_cost_line()
+    assert [float(r["air_pct"]) for r in rows[::12]] == [pytest.approx(committed["air_fraction"] * 100, rel=1e-11), 4]
+    assert {r["committed"] for r in rows[:12]} == {"true"} and {r["committed"] for r in rows[12:]} == {"false"}
+    assert float(rows[0]["fit_cost"]) == pytest.approx(best, rel=1e-11)
+    assert float(rows[0]["cost_line"]) == pytest.approx(best + noise, rel=1e-11)
+    assert {r["inside_box"] for r in rows[12:]} == {"false"}
+    for k, fraction in enumerate((committed["air_fraction"], 0.04)):
+        plant = as_built_plant({**committed, "air_fraction": fraction})
+        plain = run_many([cell_scenario(cell, plant, s) for cell in PREDICTION_CELLS for s in (0, 1)])
+        means = [np.mean([math.degrees(r.metrics.rmse) for r in plain[2 * i:2 * i + 2]])
+                 for i in range(len(PREDICTION_CELLS))]
+        assert [float(r["rmse_mean_deg"]) for r in rows[12 * k:12 * k + 12]] == pytest.approx(means, rel=1e-11)
+        assert [(r["controller"], float(r["payload_g"]), r["orientation"]) for r in rows[12 * k:12 * k + 12]] == [
+            (c, g, o) for c, _, g, o in PREDICTION_CELLS]
+    assert "A what-if, not a fit" in (tmp_path / "air" / "air.txt").read_text()

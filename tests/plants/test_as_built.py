@@ -622,3 +622,19 @@ def test_measured_position_is_the_hall_reading_without_noise():
     trace = run(Scenario("pva", 1, plant=plant, seed=1, noise=False)).trace
     hall = HallReading(plant.params.hall, plant.params.gears.spur_radius)(trace.rack_position)
     assert np.array_equal(trace.measured_position, hall)
+
+
+def test_calibration_cost_line_reads_the_committed_file_and_refuses_a_broken_one(tmp_path):
+    """The committed file's cost and noise as written; a file without them, or with a negative noise, is a
+    one-line error naming the file."""
+    import json
+
+    from twin.plants.as_built import CALIBRATION_FILE, calibration_cost_line
+
+    record = json.loads(CALIBRATION_FILE.read_text())
+    assert calibration_cost_line() == (record["cost"], record["noise"]["std"])
+    for broken in ({"cost": 0.5}, {"cost": 0.5, "noise": {"std": "x"}}, {"cost": 0.5, "noise": {"std": -0.1}}):
+        path = tmp_path / "c.json"
+        path.write_text(json.dumps(broken))
+        with pytest.raises(InvalidScenario, match="cannot read the as-built calibration .*c.json"):
+            calibration_cost_line(path)

@@ -91,6 +91,21 @@ def _profiled(members: Sequence[dict]) -> list[str]:
             + [n for n in carried if n not in calibrate.PROFILED and len({m[n] for m in members}) > 1])
 
 
+def _fixed_text(members: Sequence[dict]) -> str:
+    """A sentence on the fitted parameters every member of ``members`` shares and the fit never profiled
+    (:func:`_profiled` leaves them out), or "" if there are none."""
+    fixed = [n for n in PARAMETER_TEXT if all(n in m for m in members) and n not in _profiled(members)]
+    if not fixed:
+        return ""
+    text = ("Every member has the same " + " and ".join(_member_text(members[0], [n]) for n in fixed)
+            + ": the fit does not profile " + ("it" if len(fixed) == 1 else "them")
+            + ", so the band does not show what " + ("it does" if len(fixed) == 1 else "they do") + ".")
+    if "air_fraction" in fixed:
+        text += (" `twin whatif air` runs these cells with the air moved and the fit's cost beside each value "
+                 "(nothing else refitted).")
+    return text
+
+
 def _spans_text(members: Sequence[dict]) -> str:
     """The span of each profiled parameter over the ensemble's ``members`` (one value said as such)."""
     parts = []
@@ -1597,7 +1612,8 @@ def report(v: Validation) -> str:
               f"error passed {STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). The members, in order: "
               + "; ".join(f"{PARAMETER_TEXT[n][0]}" + (f" ({PARAMETER_TEXT[n][2]})" if PARAMETER_TEXT[n][2] else "")
                           + ": " + ", ".join(PARAMETER_TEXT[n][1](m[n]) for m in d["members"])
-                          for n in _profiled(d["members"])) + ".", "",
+                          for n in _profiled(d["members"])) + "." + (f" {_fixed_text(d['members'])}"
+                                                                     if _fixed_text(d["members"]) else ""), "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | members (lowest-highest) | stalled |",
               "|---|---|---|---|---|---|---|---|---|"]
     for r, means in zip(v.prediction, member_means(d), strict=True):

@@ -43,6 +43,7 @@ import dataclasses
 import hashlib
 import importlib.resources
 import json
+import math
 import pathlib
 from collections.abc import Iterable
 
@@ -178,6 +179,21 @@ def ensemble_values(path: pathlib.Path = CALIBRATION_FILE) -> list[dict[str, flo
             for k, m in enumerate(members)]
 
 
+def calibration_cost_line(path: pathlib.Path = CALIBRATION_FILE) -> tuple[float, float]:
+    """The fitted values' cost and its seed-to-seed noise from ``path``: ``twin calibrate`` drew its ensemble
+    from every evaluated set with cost <= cost + noise."""
+    record = _record(path)
+    try:
+        best, noise = float(record["cost"]), float(record["noise"]["std"])
+    except (TypeError, ValueError, KeyError) as error:
+        raise InvalidScenario(f"cannot read the as-built calibration {path}: its cost and noise: {error!r} missing "
+                              "or not a number") from None
+    if not (math.isfinite(best) and math.isfinite(noise) and noise >= 0):
+        raise InvalidScenario(f"cannot read the as-built calibration {path}: cost {best} and noise {noise} must be "
+                              "finite, the noise not negative")
+    return best, noise
+
+
 def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) -> tuple[JointParams, dict]:
     """Joint parameters with the fitted ``values``, minus the effects named in ``without``;
     also the plant options (gain set, scoring) those effects set."""
@@ -239,4 +255,4 @@ def preset_digest(path: pathlib.Path = CALIBRATION_FILE) -> str:
 
 __all__ = ["ASSUMED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "FITTED",
            "FULL_DUTY_SPEED_DIGIT", "FULL_DUTY_WINDOW", "SLOWEST_FULL_DUTY_SPEED", "STICTION_SCATTER",
-           "as_built_params", "as_built_plant", "calibrated_values", "ensemble_plants", "ensemble_values", "preset_digest"]
+           "as_built_params", "as_built_plant", "calibrated_values", "calibration_cost_line", "ensemble_plants", "ensemble_values", "preset_digest"]

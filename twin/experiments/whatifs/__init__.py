@@ -10,6 +10,7 @@ pva-rate   FF + PVA updated inside the PWM period (SPEC §10), over the calibrat
 observer   a Kalman velocity/acceleration observer against eq. 5.2.2's (SPEC §10), over the ensemble
 next-experiment  which rig experiment narrows the Chapter 6 prediction bands most per hour
 smc-phi    sliding mode against its boundary layer phi on every measured sliding-mode cell (nothing else changes)
+air        the T3 prediction against the chambers' free air, the fit's cost beside it (nothing else refitted)
 
 A new what-if is a new module with an ``EXPERIMENT`` object, listed in ``WHATIFS``.
 """
@@ -17,6 +18,7 @@ A new what-if is a new module with an ``EXPERIMENT`` object, listed in ``WHATIFS
 from __future__ import annotations
 
 from twin.experiments.whatifs import (
+    air,
     gear_load,
     lift,
     next_experiment,
@@ -29,4 +31,4 @@ from twin.experiments.whatifs import (
 )
 
 WHATIFS = {module.EXPERIMENT.name: module.EXPERIMENT for module in (payload, lift, pwm, gear_load, supply, pva_rate,
-                                                                    observer, next_experiment, smc_phi)}
+                                                                    observer, next_experiment, smc_phi, air)}

@@ -30,6 +30,19 @@ def list_flag(args: argparse.Namespace, flag: str, attribute: str, axis: str) ->
     return values
 
 
+def number_list(text: str, flag: str, what: str, convert=float) -> list:
+    """``flag``'s comma-separated values, each through ``convert``, without repeats, sorted; a one-line error
+    naming ``flag`` and ``what`` it takes ("--phis: numbers in m/s separated by commas, got '0.2,,0.3'") for an
+    empty or unreadable item. Ranges are the caller's to check."""
+    parts = [part.strip() for part in text.split(",")]
+    try:
+        if not all(parts):
+            raise ValueError(text)
+        return sorted({convert(part) for part in parts})
+    except ValueError:
+        raise InvalidScenario(f"{flag}: {what} separated by commas, got {text!r}") from None
+
+
 def batch_progress(bar, count: int):
     """``simulate``'s ``progress(done_ticks, total_ticks)`` for one batch of ``count`` scenarios, shown on
     ``bar`` (tqdm, or None: no progress) in scenarios from where it stands (the batch's scenarios advance

@@ -21,7 +21,7 @@ import numpy as np
 import twin.experiments.whatifs.ensemble as ensemble
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import progress_bar
+from twin.experiments.whatifs.common import number_list, progress_bar
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import finish_panels, plt
 
@@ -33,13 +33,7 @@ DEFAULT_RATES_MS = (1, 2, 4, 8, 16)
 
 def parse_rates(text: str) -> tuple[int, ...]:
     """``--rates``: whole milliseconds from 1 to 64, comma-separated; 16 (the thesis's) is always run."""
-    parts = [part.strip() for part in text.split(",")]
-    try:
-        if not all(parts):
-            raise ValueError(text)
-        rates = sorted({int(part) for part in parts})
-    except ValueError:
-        raise InvalidScenario(f"--rates: whole milliseconds separated by commas, got {text!r}") from None
+    rates = number_list(text, "--rates", "whole milliseconds", int)
     if not rates or not all(1 <= r <= 64 for r in rates):
         raise InvalidScenario(f"--rates: each update period must be 1-64 ms, got {text!r}")
     if rates == [THESIS_UPDATE_MS]:

@@ -21,7 +21,7 @@ from twin.exceptions import InvalidScenario
 from twin.experiments.arguments import seed_count
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.validate import RMSE_TOLERANCE
-from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
+from twin.experiments.whatifs.common import add_common_arguments, batch_progress, number_list, progress_bar
 from twin.sim.metrics import spread
 from viz.figures import finish_panels, plt
 
@@ -40,13 +40,7 @@ def measured_cells() -> list:
 
 def parse_phis(text: str) -> tuple[float, ...]:
     """``--phis``: boundary layers in m/s, comma-separated, each in (0, 10]; the plant's own phi is always run."""
-    parts = [part.strip() for part in text.split(",")]
-    try:
-        if not all(parts):
-            raise ValueError(text)
-        values = {float(part) for part in parts}
-    except ValueError:
-        raise InvalidScenario(f"--phis: numbers in m/s separated by commas, got {text!r}") from None
+    values = number_list(text, "--phis", "numbers in m/s")
     if not values or not all(math.isfinite(v) and 0 < v <= 10 for v in values):
         raise InvalidScenario(f"--phis: each phi must be in (0, 10] m/s, got {text!r}")
     return tuple(sorted(values))
