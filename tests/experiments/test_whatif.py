@@ -305,14 +305,25 @@ def test_air_answer_reads_the_line_and_which_law_leads():
     assert "air 2.83 % (the committed value): cost 0.560, under the line" in text
     assert ("air 8 % (outside the box): cost 0.950, over the line; sliding mode leads in 6 of 6 (by 0.30 deg, 6 by "
             "more than two standard errors)") in text
-    assert ("Under the line, the law ahead in most T3 cells is FF + PVA at 2, 2.83 %, sliding mode at 5 %: which law "
-            "leads on T3 turns on the air") in text
+    assert ("Under the line, ahead in most T3 cells: FF + PVA at 2, 2.83 %; sliding mode at 5 %. Which law leads on "
+            "T3 turns on the air") in text
     assert "on its own 10 seeds; on other seed sets a cost moves by about the noise (0.140)" in text
+
+    def verdict(kept: list[dict]) -> str:
+        return answer(kept, seeds=5, best=0.56, noise=0.14, box_pct=(0.0, 3.0)).splitlines()[-1]
+
     same = [r for r in rows if r["air_pct"] != 5.0]
-    assert ("Under the line, FF + PVA at 2, 2.83 % leads in most T3 cells: which law leads does not turn on the air"
-            in answer(same, seeds=5, best=0.56, noise=0.14, box_pct=(0.0, 3.0)))
-    over = [dict(r, under_line=False) for r in rows]
-    assert "No air value run is under the line" in answer(over, seeds=5, best=0.56, noise=0.14, box_pct=(0.0, 3.0))
+    assert verdict(same).startswith("Under the line, ahead in most T3 cells: FF + PVA at 2, 2.83 %. The other law "
+                                    "leads at none of these values: which law leads does not turn on the air")
+    tie = _t3([2.0, 2.0, 2.0, 2.3, 2.3, 2.3], [2.2, 2.2, 2.2, 2.0, 2.0, 2.0])  # three cells each: no majority
+    with_tie = same + _air_rows(3.0, 0.6, tie)
+    assert verdict(with_tie).startswith("Under the line, ahead in most T3 cells: FF + PVA at 2, 2.83 %; neither law at "
+                                        "3 %. The other law leads at none")
+    assert verdict(_air_rows(3.0, 0.6, tie)).startswith("Under the line, neither law leads in most T3 cells at any")
+    assert verdict([dict(r, under_line=False) for r in rows]).startswith("No air value run is under the line")
+    near = answer(_air_rows(2.8264187, 0.56, ffpva_ahead, committed=True) + _air_rows(2.83, 0.6, ffpva_ahead),
+                  seeds=5, best=0.56, noise=0.14, box_pct=(0.0, 3.0))
+    assert "air 2.826 % (the committed value)" in near and "air 2.83 % (inside the box)" in near
     one = answer(_air_rows(3.0, 0.6, ffpva_ahead, std=0.0), seeds=1, best=0.56, noise=0.14, box_pct=(0.0, 3.0))
     assert "over seed 0," in one and "(by 0.20 deg);" in one and "standard errors" not in one
 
@@ -334,7 +345,10 @@ def test_whatif_air_scores_as_the_fit_does_and_moves_the_air_alone(tmp_path):
     assert {r["committed"] for r in rows[:12]} == {"true"} and {r["committed"] for r in rows[12:]} == {"false"}
     assert float(rows[0]["fit_cost"]) == pytest.approx(best, rel=1e-11)
     assert float(rows[0]["cost_line"]) == pytest.approx(best + noise, rel=1e-11)
+    assert {(r["inside_box"], r["under_line"]) for r in rows[:12]} == {("true", "true")}
     assert {r["inside_box"] for r in rows[12:]} == {"false"}
+    assert (f"air {committed['air_fraction'] * 100:.4g} % (the committed value): cost {best:.3f}, under the line"
+            in (tmp_path / "air" / "air.txt").read_text())
     for k, fraction in enumerate((committed["air_fraction"], 0.04)):
         plant = as_built_plant({**committed, "air_fraction": fraction})
         plain = run_many([cell_scenario(cell, plant, s) for cell in PREDICTION_CELLS for s in (0, 1)])

@@ -633,8 +633,11 @@ def test_calibration_cost_line_reads_the_committed_file_and_refuses_a_broken_one
 
     record = json.loads(CALIBRATION_FILE.read_text())
     assert calibration_cost_line() == (record["cost"], record["noise"]["std"])
-    for broken in ({"cost": 0.5}, {"cost": 0.5, "noise": {"std": "x"}}, {"cost": 0.5, "noise": {"std": -0.1}}):
+    for broken, words in (({"cost": 0.5}, "its cost and noise: KeyError.*missing or not a number"),
+                          ({"cost": 0.5, "noise": {"std": "x"}}, "missing or not a number"),
+                          ({"cost": 0.5, "noise": {"std": -0.1}}, "must be finite, the noise not negative"),
+                          ({"cost": math.nan, "noise": {"std": 0.1}}, "cost nan and noise 0.1 must be finite")):
         path = tmp_path / "c.json"
         path.write_text(json.dumps(broken))
-        with pytest.raises(InvalidScenario, match="cannot read the as-built calibration .*c.json"):
+        with pytest.raises(InvalidScenario, match=f"^cannot read the as-built calibration .*c.json: .*{words}"):
             calibration_cost_line(path)

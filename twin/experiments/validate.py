@@ -1604,6 +1604,7 @@ def report(v: Validation) -> str:
                          + f" | {_fmt(r['ratio'])} |")
         lines.append("")
     d = v.prediction_detail
+    fixed = _fixed_text(d["members"])
     lines += ["## Prediction: Chapter 6 T3 (blind)", "",
               f"The held-back T3 cells, predicted on the committed preset (five runs) and on each of the "
               f"{len(d['members'])} members of the calibration ensemble (five runs each). The band is the 10-90 % "
@@ -1612,8 +1613,7 @@ def report(v: Validation) -> str:
               f"error passed {STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). The members, in order: "
               + "; ".join(f"{PARAMETER_TEXT[n][0]}" + (f" ({PARAMETER_TEXT[n][2]})" if PARAMETER_TEXT[n][2] else "")
                           + ": " + ", ".join(PARAMETER_TEXT[n][1](m[n]) for m in d["members"])
-                          for n in _profiled(d["members"])) + "." + (f" {_fixed_text(d['members'])}"
-                                                                     if _fixed_text(d["members"]) else ""), "",
+                          for n in _profiled(d["members"])) + "." + (f" {fixed}" if fixed else ""), "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | members (lowest-highest) | stalled |",
               "|---|---|---|---|---|---|---|---|---|"]
     for r, means in zip(v.prediction, member_means(d), strict=True):

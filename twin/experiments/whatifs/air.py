@@ -35,7 +35,7 @@ COLUMNS = ("air_pct", "committed", "inside_box", "fit_cost", "cost_line", "under
            "payload_g", "orientation", "rmse_mean_deg", "rmse_std_deg")
 DEFAULT_AIR_PCT = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0)
 AIR_LIMIT_PCT = 20.0  # past this the chambers are more air than a water joint; the plant is not meant for it
-MAX_VALUES = 50  # air values in one run (each costs the fit's 210 runs besides the T3 cells)
+MAX_VALUES = 50  # air values given in one run, the committed one added besides (each costs the fit's 210 runs)
 LAWS = ("ffpva", "smc")
 
 
@@ -46,12 +46,19 @@ def parse_air(text: str) -> tuple[float, ...]:
     if not all(math.isfinite(v) and 0 <= v <= AIR_LIMIT_PCT for v in values):
         raise InvalidScenario(f"--air: each value must be 0-{AIR_LIMIT_PCT:g} % of the chamber volume, got {text!r}")
     if len(values) > MAX_VALUES:
-        raise InvalidScenario(f"--air: at most {MAX_VALUES} values in one run, got {len(values)}")
+        raise InvalidScenario(f"--air: at most {MAX_VALUES} values in one run (the committed one is added besides), "
+                              f"got {len(values)}")
     return tuple(sorted(values))
 
 
 def _cell(r: dict) -> tuple:
     return r["payload_g"], r["orientation"]
+
+
+def _pct(air: float) -> str:
+    """An air value as the answer writes it: four significant digits, so the committed 2.826 % and a given 2.83
+    read apart."""
+    return f"{air:.4g}"
 
 
 def _cell_label(cell: tuple) -> str:
@@ -144,7 +151,7 @@ def answer(rows: Sequence[dict], *, seeds: int, best: float, noise: float, box_p
         where = ("the committed value" if r["committed"] else "inside the box" if r["inside_box"]
                  else "outside the box")
         cells = {(c["controller"], *_cell(c)): c["rmse_mean_deg"] for c in rows if c["air_pct"] == air}
-        lines.append(f"air {air:.3g} % ({where}): cost {r['fit_cost']:.3f}, "
+        lines.append(f"air {_pct(air)} % ({where}): cost {r['fit_cost']:.3f}, "
                      f"{'under' if r['under_line'] else 'over'} the line; {_lead_text(margin)}. "
                      + ", ".join(f"{_cell_label(k)} {cells[(LAWS[0], *k)]:.2f} / {cells[(LAWS[1], *k)]:.2f}"
                                  for k in margin))
@@ -152,18 +159,21 @@ def answer(rows: Sequence[dict], *, seeds: int, best: float, noise: float, box_p
     majorities = {air: _majority(margins[air]) for air in under}
     named = {LAWS[0]: "FF + PVA", LAWS[1]: "sliding mode", None: "neither law"}
     groups = {law: [air for air in under if majorities[air] == law] for law in dict.fromkeys(majorities.values())}
-    said = ", ".join(f"{named[law]} at {', '.join(f'{a:.3g}' for a in airs)} %" for law, airs in groups.items())
+    said = "; ".join(f"{named[law]} at {', '.join(_pct(a) for a in airs)} %" for law, airs in groups.items())
+    leaders = [law for law in groups if law is not None]
     if not under:
         verdict = "No air value run is under the line, the committed one included: the line cannot be read here."
-    elif len(groups) == 1:
-        verdict = (f"Under the line, {said} leads in most T3 cells: which law leads does not turn on the air, as "
-                   "far as these values show.")
+    elif len(leaders) == 2:
+        verdict = (f"Under the line, ahead in most T3 cells: {said}. Which law leads on T3 turns on the air, which "
+                   "the measurements do not pin down.")
+    elif leaders:
+        verdict = (f"Under the line, ahead in most T3 cells: {said}. The other law leads at none of these values: "
+                   "which law leads does not turn on the air, as far as they show.")
     else:
-        verdict = (f"Under the line, the law ahead in most T3 cells is {said}: which law leads on T3 turns on the "
-                   "air, which the measurements do not pin down.")
-    lines.append(verdict + f" The line is the calibration's rule on its own {len(calibrate.FIT_SEEDS)} seeds; on other seed sets a cost moves "
-                 f"by about the noise ({noise:.3f}), so a value near the line may fall on either side of it. A "
-                 "what-if, not a fit: every other command runs the committed preset.")
+        verdict = "Under the line, neither law leads in most T3 cells at any value run."
+    lines.append(f"{verdict} The line is the calibration's rule on its own {len(calibrate.FIT_SEEDS)} seeds; on other "
+                 f"seed sets a cost moves by about the noise ({noise:.3f}), so a value near the line may fall on "
+                 "either side of it. A what-if, not a fit: every other command runs the committed preset.")
     return "\n".join(lines)
 
 
