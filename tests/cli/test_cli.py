@@ -37,6 +37,7 @@ def run_json(cwd: pathlib.Path, *args: str) -> dict:
     return record
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26, a later session's slower machine)
 def test_run_json_prints_one_record(tmp_path):
     record = run_json(tmp_path, "--seed", "0")
     assert REQUIRED_KEYS <= set(record)

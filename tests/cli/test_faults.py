@@ -616,6 +616,7 @@ def test_sigterm_stops_an_experiment_as_ctrl_c_does(tmp_path, capsys, monkeypatc
         signal.signal(signal.SIGTERM, before)
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26, a later session's slower machine)
 def test_a_figure_that_cannot_be_drawn_costs_no_table(tmp_path, capsys, monkeypatch):
     """A plotting library's error (not the disk's) leaves the tables written: exit 1, one line naming the
     figure, and no figure of an earlier run left to pass for this one's."""

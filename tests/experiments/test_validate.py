@@ -824,6 +824,7 @@ def test_report_says_on_how_many_members_each_controller_order_is_right():
         "what_the_twin_shows"]
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26, a later session's slower machine)
 def test_payload_phases_split_each_runs_squared_error_between_the_move_and_the_hold(monkeypatch):
     """On one run per cell the move's and the hold's mean squared errors, weighted by their ticks (1 s and 2 s
     of T1), make up the run's RMSE."""

@@ -162,6 +162,7 @@ def test_whatif_rejects_a_bad_list_naming_its_flag_and_writes_nothing(tmp_path, 
     assert not out.exists()
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26, a later session's slower machine)
 def test_supply_variants_differ_in_the_supply_alone_and_sag_as_their_compliance_says():
     """The constant supply holds 300 kPa exactly; the line sags while water flows; the accumulator's extra
     compliance at the valve block makes the same flow sag it less (the line's dip scales with sqrt(L / C))."""

@@ -524,6 +524,7 @@ def test_each_effect_alone_changes_the_run(effect, thesis_t4):
     assert not same(result, thesis_t4("ffpva")), f"{effect} alone changes nothing"
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26, a later session's slower machine)
 def test_load_friction_alone_changes_only_a_loaded_run(thesis_t4):
     """Horizontal, gravity is along the shaft and the train carries no load: the thesis plant's run
     exactly. Vertical with 13.5 g, the load friction slows the lift: a larger error."""
@@ -535,6 +536,7 @@ def test_load_friction_alone_changes_only_a_loaded_run(thesis_t4):
     assert with_load.metrics.rmse > 1.1 * thesis.metrics.rmse
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26, a later session's slower machine)
 def test_the_supply_line_changes_the_compressible_run():
     """The line is integrated with the chambers, so it is switched on on top of them."""
     chambers = run(Scenario("ffpva", 4, plant=as_built_plant(

@@ -55,6 +55,7 @@ def test_batching_does_not_change_a_scenario():
     assert _same(batch[3], single)
 
 
+@pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26, a later session's slower machine)
 def test_an_as_built_batch_whose_ended_runs_stop_gives_the_numbers_of_one_that_runs_them_on(monkeypatch):
     """In a batch the solenoid valves and chambers of a run that has ended stop being advanced (a
     saving); every run's numbers, every trace field, are those of a loop that advances them to the batch's

@@ -250,6 +250,9 @@ class ObserverParams:
             raise InvalidParameter(f"observer kind must be one of {', '.join(OBSERVER_KINDS)}, got {self.kind!r}")
 
 
+AIR_FRACTION_MAX = 0.2  # free air per chamber volume the chamber model takes: past it, more air than a water joint
+
+
 @dataclasses.dataclass(frozen=True)
 class ChamberParams:
     """Compressible chambers (as-built; §3: "trapped air lowers" beta).
@@ -273,8 +276,8 @@ class ChamberParams:
 
     def __post_init__(self) -> None:
         _require_positive(self, "water_bulk_modulus", "dead_volume", "atmospheric_pressure")
-        if not 0.0 <= self.air_fraction <= 0.2:
-            raise InvalidParameter(f"air_fraction must be in [0, 0.2], got {self.air_fraction}")
+        if not 0.0 <= self.air_fraction <= AIR_FRACTION_MAX:
+            raise InvalidParameter(f"air_fraction must be in [0, {AIR_FRACTION_MAX}], got {self.air_fraction}")
         if self.leak_conductance < 0 or self.substeps < 1:
             raise InvalidParameter("leak_conductance must be >= 0 and substeps >= 1")
 

@@ -28,13 +28,14 @@ from twin.experiments import calibrate
 from twin.experiments.arguments import seed_count
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import number_list, progress_bar
+from twin.physics.params import AIR_FRACTION_MAX
 from twin.sim.metrics import spread
 from viz.figures import finish_panels, plt
 
 COLUMNS = ("air_pct", "committed", "inside_box", "fit_cost", "cost_line", "under_line", "controller", "trajectory",
            "payload_g", "orientation", "rmse_mean_deg", "rmse_std_deg")
 DEFAULT_AIR_PCT = (1.0, 2.0, 3.0, 4.0, 5.0, 6.0, 8.0)
-AIR_LIMIT_PCT = 20.0  # past this the chambers are more air than a water joint; the plant is not meant for it
+AIR_LIMIT_PCT = AIR_FRACTION_MAX * 100  # what the chamber model takes, in %
 MAX_VALUES = 50  # air values given in one run, the committed one added besides (each costs the fit's 210 runs)
 LAWS = ("ffpva", "smc")
 
