@@ -94,7 +94,8 @@ def _profiled(members: Sequence[dict]) -> list[str]:
 def _fixed_text(members: Sequence[dict]) -> str:
     """A sentence on the fitted parameters every member of ``members`` shares and the fit never profiled
     (:func:`_profiled` leaves them out), or "" if there are none."""
-    fixed = [n for n in PARAMETER_TEXT if all(n in m for m in members) and n not in _profiled(members)]
+    shown = _profiled(members)
+    fixed = [n for n in PARAMETER_TEXT if all(n in m for m in members) and n not in shown]
     if not fixed:
         return ""
     text = ("Every member has the same " + " and ".join(_member_text(members[0], [n]) for n in fixed)

@@ -41,15 +41,15 @@ LAWS = ("ffpva", "smc")
 
 
 def parse_air(text: str) -> tuple[float, ...]:
-    """``--air``: free air in % of the chamber volume, comma-separated, each 0-20; the committed value is
-    always run besides."""
+    """``--air``: free air in % of the chamber volume, comma-separated, each from 0 to the chamber model's
+    limit; the committed value is always run besides."""
     values = number_list(text, "--air", "percentages")
     if not all(math.isfinite(v) and 0 <= v <= AIR_LIMIT_PCT for v in values):
         raise InvalidScenario(f"--air: each value must be 0-{AIR_LIMIT_PCT:g} % of the chamber volume, got {text!r}")
     if len(values) > MAX_VALUES:
         raise InvalidScenario(f"--air: at most {MAX_VALUES} values in one run (the committed one is added besides), "
                               f"got {len(values)}")
-    return tuple(sorted(values))
+    return tuple(values)  # number_list sorts them
 
 
 def _cell(r: dict) -> tuple:
@@ -74,7 +74,7 @@ def air_study(*, air_pct: Sequence[float], seeds: int = 5, workers: int = 2, bar
 
     committed = calibrated_values()
     best, noise = calibration_cost_line()
-    box = next(f for f in FITTED if f.name == "air_fraction")
+    box = FITTED[calibrate.FITTED_INDEX["air_fraction"]]
     points = {x / 100: x for x in air_pct}  # fraction -> % as given
     points.setdefault(committed["air_fraction"], committed["air_fraction"] * 100)
     t3_seeds = tuple(range(seeds))
