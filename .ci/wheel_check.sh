@@ -11,7 +11,7 @@ python3 -m venv "$work/build-venv"
 wheel=$(ls "$work"/dist/*.whl)
 echo "wheel: $(basename "$wheel")"
 listing=$(python3 -m zipfile -l "$wheel")
-for needed in models/joint.xml twin/plants/data/as_built.json viz/live_page.html viz/recording_page.html viz/strip_chart.js; do
+for needed in models/joint.xml twin/plants/data/as_built.json twin/experiments/data/t3_prediction.csv viz/live_page.html viz/recording_page.html viz/strip_chart.js; do
   grep -q "^$needed " <<<"$listing" || { echo "wheel check: $needed is missing from the wheel" >&2; exit 1; }
 done
 python3 -m venv "$work/venv"

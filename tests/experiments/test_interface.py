@@ -32,6 +32,16 @@ def test_the_cli_offers_exactly_the_registered_experiments(command, registry, ca
         assert name in shown
 
 
+def test_the_top_level_help_names_every_registered_experiment(capsys):
+    """``twin --help`` summarises each group from its registry (it once named five what-ifs of ten)."""
+    with pytest.raises(SystemExit):
+        main(["--help"])
+    shown = " ".join(capsys.readouterr().out.split())  # argparse wraps the summaries
+    for command, registry in (("whatif", WHATIFS), ("study", STUDIES)):
+        summary = shown.split(f" {command} ", 1)[1]
+        assert all(f"{name}," in summary or f"{name} " in summary for name in registry), command
+
+
 class Recorder(Experiment):
     """A what-if that records the order the CLI drives it in."""
 

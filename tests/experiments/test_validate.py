@@ -14,6 +14,7 @@ import pytest
 
 from twin.experiments import validate
 from twin.experiments.reference import THESIS_PAYLOADS_G
+from twin.plants.as_built import ensemble_values
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 VALIDATION_COLUMNS = ["source", "controller", "trajectory", "payload_g", "orientation", "plant", "measured",
@@ -101,6 +102,13 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
         (r["controller"], f"{float(r['payload_g']):g} g", r["orientation"]): [
             *(f"{float(r[k]):.2f}" for k in ("twin_mean", "band_p10", "band_p50", "band_p90")), r["stalled_runs"]]
         for r in predicted}, "docs/prediction.md's current table is stale"
+    # The prediction `twin score` holds against measurements by default is this run's, digit for digit.
+    columns, members = rows_of(out / "prediction_members.csv")
+    assert columns == list(validate.PREDICTION_MEMBER_COLUMNS) and len(members) == 12 * len(ensemble_values())
+    for fresh, packaged in (("prediction.csv", "t3_prediction.csv"),
+                            ("prediction_members.csv", "t3_prediction_members.csv")):
+        assert (out / fresh).read_text() == (ROOT / "twin" / "experiments" / "data" / packaged).read_text(), (
+            f"twin/experiments/data/{packaged} is stale: copy a fresh twin validate's {fresh} there")
 
 
 def _rows(text: str) -> list[list[str]]:

@@ -4,10 +4,11 @@
     twin run --controller ffpva --trajectory 1 --json      one scenario
     twin bench                     cost per simulated second
     twin view --controller smc --trajectory 4              the joint live in a browser
-    twin whatif payload --out DIR                          tracking against payload (also lift, pwm, gear-load, supply)
+    twin whatif payload --out DIR                          tracking against payload; `twin whatif -h` lists the rest
     twin study robustness --out DIR                        the thesis's Chapter 6 protocol
     twin study ablation --out DIR                          each as-built effect off in turn, against SPEC §8
     twin validate --out DIR                                every published comparison and the blind T3 prediction
+    twin score --measured FILE --out DIR                   that prediction against measured T3 cells
 
 Degrees, grams and kPa here; SI inside. Bad input gets a one-line error and
 exit code 2, and nothing is written. One module per command; each adds its own
@@ -19,11 +20,11 @@ from __future__ import annotations
 import argparse
 import sys
 
-from twin.cli import bench, calibrate, demo, experiments, run, sweep, validate, view
+from twin.cli import bench, calibrate, demo, experiments, run, score, sweep, validate, view
 from twin.cli.common import EXIT_INTERRUPTED, EXIT_USAGE, Parser
 from twin.exceptions import TwinError
 
-COMMANDS = (demo, bench, sweep, experiments, run, calibrate, validate, view)
+COMMANDS = (demo, bench, sweep, experiments, run, calibrate, validate, score, view)
 
 
 def build_parser() -> argparse.ArgumentParser:

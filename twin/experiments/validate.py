@@ -121,6 +121,9 @@ VALIDATION_COLUMNS = ("source", "controller", "trajectory", "payload_g", "orient
                       "twin_mean", "twin_std", "ratio", "within_tolerance")
 PREDICTION_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "twin_mean", "band_p10", "band_p50",
                       "band_p90", "stalled_runs")
+# Each ensemble member's mean per T3 cell (member 0 is the first the calibration file lists), so that the band
+# and the members' range can be read again, and the prediction scored, from the files alone (`twin score`).
+PREDICTION_MEMBER_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "member", "twin_mean")
 # Forty more runs per measured cell, on noise seeds no step of `twin calibrate` ever ran (it fits on
 # FIT_SEEDS and measures its cost's noise on NOISE_SEED_SETS): eight five-run groups, to show how much of
 # each verdict on seeds 0-4 is the draw of five runs. Forty, as many runs per cell as the calibration's four
@@ -762,6 +765,14 @@ def member_means(detail: dict) -> np.ndarray:
     """Each ensemble member's five-run mean RMSE per T3 cell, (cells, members), from ``prediction``'s
     detail."""
     return np.array(detail["per_member"]).T
+
+
+def prediction_member_rows(prediction_rows: Sequence[dict], detail: dict) -> list[dict]:
+    """One row per T3 cell and ensemble member (:data:`PREDICTION_MEMBER_COLUMNS`), the cells in
+    ``prediction_rows``' order."""
+    return [{**{k: r[k] for k in ("controller", "trajectory", "payload_g", "orientation")}, "member": m,
+             "twin_mean": float(mean)}
+            for r, means in zip(prediction_rows, member_means(detail), strict=True) for m, mean in enumerate(means)]
 
 
 @dataclasses.dataclass
@@ -1787,15 +1798,18 @@ class ValidateExperiment(Experiment):
         return Outcome(rows=v.rows, answer=answer, failed=v.failed, detail=v)
 
     def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
-        """``validation.csv``, ``prediction.csv``, ``validation.md`` and its figures, ``seeds.csv``
+        """``validation.csv``, ``prediction.csv``, ``validation.md``, ``prediction_members.csv``
+        (:func:`prediction_member_rows`) and the figures, ``seeds.csv``
         (:func:`seed_rows`), ``effects.csv`` (:func:`payload_effects`) and ``misses.csv`` (:func:`misses`)
         (the CLI's :meth:`publish` makes them all or nothing; a figure that cannot be drawn is left out and
         named in ``undrawn``)."""
         v = outcome.detail
-        paths = [out / "validation.csv", out / "prediction.csv", out / "validation.md"]
+        paths = [out / "validation.csv", out / "prediction.csv", out / "validation.md",
+                 out / "prediction_members.csv"]
         write_csv(v.rows, VALIDATION_COLUMNS, paths[0])
         write_csv(v.prediction, PREDICTION_COLUMNS, paths[1])
         paths[2].write_text(report(v))
+        write_csv(prediction_member_rows(v.prediction, v.prediction_detail), PREDICTION_MEMBER_COLUMNS, paths[3])
         paths += drawn(lambda path: figure_validation(v.rows, path), out / "validation.png", undrawn)
         paths += drawn(lambda path: figure_prediction(v, path), out / "prediction.png", undrawn)
         paths += drawn(lambda path: figure_pulses(v, path), out / "pulses.png", undrawn)

@@ -1,0 +1,350 @@
+"""``twin score --measured FILE --out DIR``: the blind T3 prediction held against the measured Chapter 6 T3
+cells, by rules written down on 2026-11-26, before any T3 measurement was seen.
+
+The prediction is the committed one (``data/t3_prediction.csv`` and ``data/t3_prediction_members.csv`` beside
+this module: ``twin validate``'s ``prediction.csv`` and ``prediction_members.csv`` on the committed as-built
+preset), or the one in a ``twin validate`` output folder (``--prediction DIR``). The measurements are a CSV
+with one row per T3 cell, twelve in all (:data:`MEASURED_COLUMNS`; ``trajectory``, ``runs`` and
+``stalled_runs`` may be left out: T3, five runs, not stated)::
+
+    controller,payload_g,orientation,rmse_mean_deg,rmse_std_deg
+    smc,13.5,vertical,3.1,0.4
+    ...
+
+``controller`` is ``ffpva`` or ``smc`` (or ``FF + PVA``, ``sliding mode``).
+
+The rules (:func:`score`). Changing one after a measurement has been seen is a new rule, to be said so.
+
+* Per cell: ``ratio`` = the committed preset's mean over the measured mean; ``within`` when it is within
+  20 % (the tolerance of every measured RMSE in ``twin validate``); ``in_band`` when the measured mean lies in
+  the ensemble's 10-90 % band; ``in_members`` when it lies in the members' range (lowest to highest member
+  mean); ``z``, the committed mean's distance from the measured mean in the measured mean's standard errors
+  (std / sqrt(runs)).
+* Per payload and orientation: which controller tracked better, measured and predicted (the committed
+  means); the measured order is **a toss** when the two measured means differ by less than two combined
+  standard errors.
+* The thesis's three robustness conclusions, on T3, measured and predicted: (1) the cost of 13.5 g
+  horizontal, 13.5 g over 0 g horizontal, per controller; (2) the cost of 13.5 g vertical, 13.5 g over 0 g
+  vertical, per controller, and the stalled runs; (3) in how many of the six payload-and-orientation pairs
+  sliding mode tracked better than FF + PVA. A cost ratio agrees when the predicted one is within 20 % of
+  the measured one.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import importlib.resources
+import math
+import pathlib
+
+import numpy as np
+
+from twin.batch.tables import write_csv
+from twin.exceptions import InvalidScenario
+from twin.experiments.base import Experiment, Outcome, drawn
+from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
+from twin.experiments.validate import (
+    PREDICTION_CELLS,
+    PREDICTION_COLUMNS,
+    PREDICTION_MEMBER_COLUMNS,
+    RMSE_TOLERANCE,
+    rmse_within,
+)
+from twin.sim.scenario import CONTROLLER_LABELS
+
+COMMITTED = importlib.resources.files("twin.experiments") / "data"  # package data
+COMMITTED_FILES = ("t3_prediction.csv", "t3_prediction_members.csv")
+VALIDATE_FILES = ("prediction.csv", "prediction_members.csv")  # the same two, as `twin validate` names them
+RULES_WRITTEN = "2026-11-26"  # before any T3 measurement was seen
+MEASURED_COLUMNS = ("controller", "payload_g", "orientation", "rmse_mean_deg", "rmse_std_deg")
+OPTIONAL_COLUMNS = {"trajectory": 3, "runs": 5, "stalled_runs": None}  # and their values when left out
+TOSS_SE = 2.0  # measured means closer than this many combined standard errors: the order is a toss
+SCORE_COLUMNS = ("controller", "payload_g", "orientation", "measured", "measured_std", "runs", "twin_mean",
+                 "band_p10", "band_p90", "member_low", "member_high", "ratio", "within", "in_band", "in_members", "z")
+ORDER_COLUMNS = ("payload_g", "orientation", "measured_better", "measured_toss", "predicted_better", "right")
+CONTROLLER_NAMES = {**{name: name for name in CONTROLLER_LABELS}, **{label.lower(): name for name, label in
+                                                                      CONTROLLER_LABELS.items()}}
+CELL_KEYS = tuple((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # (controller, payload g, orientation)
+
+
+def _read(path: pathlib.Path, what: str) -> tuple[list[str], list[dict]]:
+    try:
+        with open(path, newline="", encoding="utf-8") as handle:
+            reader = csv.DictReader(handle)
+            return [c.strip() for c in reader.fieldnames or []], [{k.strip(): (v or "").strip() for k, v in row.items()
+                                                                   if k is not None} for row in reader]
+    except FileNotFoundError:
+        raise InvalidScenario(f"{what} {str(path)!r} does not exist") from None
+    except IsADirectoryError:
+        raise InvalidScenario(f"{what} {str(path)!r} is a folder, not a CSV file") from None
+    except (OSError, UnicodeDecodeError, csv.Error) as error:
+        raise InvalidScenario(f"cannot read {what} {str(path)!r}: {error}") from None
+
+
+def _number(text: str, where: str, column: str, *, low: float = 0.0, positive: bool = False) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value) or value < low or (positive and value <= 0):
+        need = "a positive number" if positive else f"a number of at least {low:g}"
+        raise InvalidScenario(f"{where}: {column} must be {need}, got {text!r}")
+    return value
+
+
+def _cell_key(row: dict, where: str) -> tuple[str, float, str]:
+    name = CONTROLLER_NAMES.get(row["controller"].lower())
+    if name not in ("ffpva", "smc"):
+        raise InvalidScenario(f"{where}: controller must be ffpva or smc (FF + PVA, sliding mode), "
+                              f"got {row['controller']!r}")
+    payload = _number(row["payload_g"], where, "payload_g")
+    orientation = row["orientation"].lower()
+    key = (name, payload, orientation)
+    if key not in CELL_KEYS:
+        raise InvalidScenario(f"{where}: no T3 cell {CONTROLLER_LABELS[name]} {row['payload_g']} g {row['orientation']}"
+                              f" (payloads 0, 6.5, 13.5 g; horizontal or vertical)")
+    return key
+
+
+def _complete(found: dict, what: str) -> None:
+    missing = [k for k in CELL_KEYS if k not in found]
+    if missing:
+        names = ", ".join(f"{CONTROLLER_LABELS[c]} {g:g} g {o}" for c, g, o in missing)
+        raise InvalidScenario(f"{what} lacks {len(missing)} of the 12 T3 cells: {names}")
+
+
+def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
+    """The measured T3 cells, by (controller, payload g, orientation): mean, std, runs and stalled runs (None
+    when not given). Raises :class:`InvalidScenario` with one line naming the first bad row."""
+    columns, rows = _read(path, "measured file")
+    lacking = [c for c in MEASURED_COLUMNS if c not in columns]
+    if lacking:
+        raise InvalidScenario(f"measured file {str(path)!r} lacks the column(s) {', '.join(lacking)} "
+                              f"(it needs {', '.join(MEASURED_COLUMNS)})")
+    found: dict[tuple, dict] = {}
+    for line, row in enumerate(rows, start=2):
+        where = f"{path.name} line {line}"
+        if not any(row.values()):
+            continue
+        key = _cell_key(row, where)
+        if key in found:
+            raise InvalidScenario(f"{where}: {CONTROLLER_LABELS[key[0]]} {key[1]:g} g {key[2]} is given twice")
+        if row.get("trajectory", "3") not in ("", "3"):
+            raise InvalidScenario(f"{where}: only the T3 cells are scored, got trajectory {row['trajectory']!r}")
+        runs = row.get("runs") or str(OPTIONAL_COLUMNS["runs"])
+        if not runs.isdigit() or int(runs) < 2:
+            raise InvalidScenario(f"{where}: runs must be a whole number of at least 2, got {runs!r}")
+        stalled = row.get("stalled_runs") or None
+        if stalled is not None and (not stalled.isdigit() or int(stalled) > int(runs)):
+            raise InvalidScenario(f"{where}: stalled_runs must be a whole number up to runs, got {stalled!r}")
+        found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", positive=True),
+                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg"), "runs": int(runs),
+                      "stalled": None if stalled is None else int(stalled)}
+    _complete(found, f"measured file {str(path)!r}")
+    return found
+
+
+def prediction_files(folder: pathlib.Path | None) -> tuple:
+    """The prediction's two files: the committed ones, or a ``twin validate`` output folder's."""
+    if folder is None:
+        return tuple(COMMITTED / name for name in COMMITTED_FILES)
+    if not folder.is_dir():
+        raise InvalidScenario(f"--prediction {str(folder)!r} is not a folder (give a twin validate --out folder)")
+    return tuple(folder / name for name in VALIDATE_FILES)
+
+
+def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
+    """The prediction by (controller, payload g, orientation): the committed mean, the 10-90 % band, every
+    member's mean and the stalled runs."""
+    cells_path, members_path = prediction_files(folder)
+    columns, rows = _read(cells_path, "prediction file")
+    member_columns, member_rows = _read(members_path, "prediction file")
+    if columns != list(PREDICTION_COLUMNS) or member_columns != list(PREDICTION_MEMBER_COLUMNS):
+        raise InvalidScenario(f"{str(cells_path)!r} and {str(members_path)!r} are not twin validate's prediction files")
+    found: dict[tuple, dict] = {}
+    try:
+        for row in rows:
+            key = _cell_key(row, cells_path.name)
+            found[key] = {"mean": float(row["twin_mean"]), "p10": float(row["band_p10"]),
+                          "p90": float(row["band_p90"]), "stalled": int(row["stalled_runs"]), "members": []}
+        for row in member_rows:
+            found[_cell_key(row, members_path.name)]["members"].append(float(row["twin_mean"]))
+    except (KeyError, ValueError) as error:
+        raise InvalidScenario(f"cannot read the prediction in {str(cells_path.parent)!r}: {error}") from None
+    _complete(found, f"prediction {str(cells_path.parent)!r}")
+    if any(not cell["members"] for cell in found.values()):
+        raise InvalidScenario(f"{str(members_path)!r} lacks the members of some T3 cell")
+    return found
+
+
+def _cost(cells: dict, controller: str, payload_g: float, orientation: str, key: str) -> float:
+    return cells[controller, payload_g, orientation][key] / cells[controller, 0.0, orientation][key]
+
+
+def _in_standard_errors(difference: float, se: float) -> float:
+    """``difference / se``; with no spread measured (std 0), 0 or an infinity of the difference's sign."""
+    if se > 0:
+        return difference / se
+    return math.copysign(math.inf, difference) if difference else 0.0
+
+
+def score(measured: dict[tuple, dict], predicted: dict[tuple, dict]) -> dict:
+    """The rules of the module docstring: ``cells`` (:data:`SCORE_COLUMNS`), ``orders``
+    (:data:`ORDER_COLUMNS`) and ``conclusions``."""
+    cells = []
+    for key in CELL_KEYS:
+        m, p = measured[key], predicted[key]
+        se = m["std"] / math.sqrt(m["runs"])
+        ratio = p["mean"] / m["mean"]
+        cells.append({"controller": key[0], "payload_g": key[1], "orientation": key[2], "measured": m["mean"],
+                      "measured_std": m["std"], "runs": m["runs"], "twin_mean": p["mean"], "band_p10": p["p10"],
+                      "band_p90": p["p90"], "member_low": min(p["members"]), "member_high": max(p["members"]),
+                      "ratio": ratio, "within": bool(rmse_within(p["mean"], m["mean"])),
+                      "in_band": p["p10"] <= m["mean"] <= p["p90"],
+                      "in_members": min(p["members"]) <= m["mean"] <= max(p["members"]),
+                      "z": _in_standard_errors(p["mean"] - m["mean"], se)})
+    orders = []
+    for payload_g, orientation in dict.fromkeys((g, o) for _, g, o in CELL_KEYS):
+        ff, smc = measured["ffpva", payload_g, orientation], measured["smc", payload_g, orientation]
+        combined = math.hypot(ff["std"] / math.sqrt(ff["runs"]), smc["std"] / math.sqrt(smc["runs"]))
+        better = "smc" if smc["mean"] < ff["mean"] else "ffpva"
+        twin_better = "smc" if predicted["smc", payload_g, orientation]["mean"] < \
+            predicted["ffpva", payload_g, orientation]["mean"] else "ffpva"
+        orders.append({"payload_g": payload_g, "orientation": orientation, "measured_better": better,
+                       "measured_toss": abs(smc["mean"] - ff["mean"]) < TOSS_SE * combined,
+                       "predicted_better": twin_better, "right": better == twin_better})
+    conclusions = {}
+    for number, orientation in ((1, "horizontal"), (2, "vertical")):
+        conclusions[number] = {c: {"measured": _cost(measured, c, 13.5, orientation, "mean"),
+                                   "predicted": _cost(predicted, c, 13.5, orientation, "mean")}
+                               for c in ("ffpva", "smc")}
+        for both in conclusions[number].values():
+            both["agree"] = bool(rmse_within(both["predicted"], both["measured"]))
+    stalled = [measured[k]["stalled"] for k in CELL_KEYS if k[1:] == (13.5, "vertical")]
+    conclusions[2]["stalled"] = {"predicted": sum(predicted[k]["stalled"] for k in CELL_KEYS if k[1:] == (13.5, "vertical")),
+                                 "measured": None if None in stalled else sum(stalled)}
+    conclusions[3] = {"measured": sum(o["measured_better"] == "smc" for o in orders),
+                      "predicted": sum(o["predicted_better"] == "smc" for o in orders), "of": len(orders)}
+    return {"cells": cells, "orders": orders, "conclusions": conclusions}
+
+
+def _cell_name(row: dict) -> str:
+    return f"{CONTROLLER_LABELS[row['controller']]} {row['payload_g']:g} g {row['orientation']}"
+
+
+def _fitted_note() -> str:
+    """The two cells that were not blind: Chapter 5's T3 experiment, which the calibration fitted."""
+    fitted = "; ".join(f"{CONTROLLER_LABELS[c]} {THESIS_EXPERIMENT_RMSE_DEG[c][3][0]:.2f} ± "
+                       f"{THESIS_EXPERIMENT_RMSE_DEG[c][3][1]:.2f}" for c in ("ffpva", "smc"))
+    return (f"Not blind: the 0 g horizontal cells, if the measurements repeat Chapter 5's T3 experiment ({fitted}), "
+            "which `twin calibrate` fitted. The other ten were predicted before any was seen.")
+
+
+def answer(s: dict) -> str:
+    """One line: how the prediction fared."""
+    cells, orders = s["cells"], s["orders"]
+    c3 = s["conclusions"][3]
+    return (f"{sum(r['within'] for r in cells)} of {len(cells)} T3 cells within {RMSE_TOLERANCE * 100:.0f} % of the measured "
+            f"mean; {sum(r['in_band'] for r in cells)} inside the 10-90 % band, {sum(r['in_members'] for r in cells)} "
+            f"inside the members' range; controller order right in {sum(o['right'] for o in orders)} of "
+            f"{len(orders)} pairs ({sum(o['measured_toss'] for o in orders)} a toss on the measured runs); sliding "
+            f"mode better in {c3['measured']} of {c3['of']} measured, {c3['predicted']} predicted.")
+
+
+def report(s: dict, *, prediction: str, measured: str) -> str:
+    """``score.md``: the tables and the conclusions, readable on their own."""
+    lines = [
+        "# The blind T3 prediction against the measurements", "",
+        f"Written by `twin score`. Prediction: {prediction}. Measurements: {measured}. The rules were written on "
+        f"{RULES_WRITTEN}, before any T3 measurement was seen (twin/experiments/score.py). Degrees.", "",
+        "## Summary", "", answer(s), "", _fitted_note(), "",
+        "## Per cell", "",
+        "`within`: the committed preset's mean within 20 % of the measured mean. `z`: how far it is from the "
+        "measured mean, in the measured mean's standard errors (std / sqrt(runs)).", "",
+        "| cell | measured | committed | ratio | within | band p10-p90 | in band | members | in members | z |",
+        "|---|---|---|---|---|---|---|---|---|---|"]
+    yes = {True: "yes", False: "no"}
+    for r in s["cells"]:
+        lines.append(f"| {_cell_name(r)} | {r['measured']:.2f} ± {r['measured_std']:.2f} | {r['twin_mean']:.2f} | "
+                     f"x{r['ratio']:.2f} | {yes[r['within']]} | {r['band_p10']:.2f}-{r['band_p90']:.2f} | "
+                     f"{yes[r['in_band']]} | {r['member_low']:.2f}-{r['member_high']:.2f} | {yes[r['in_members']]} | "
+                     f"{r['z']:+.1f} |")
+    lines += ["", "## Which controller tracked better", "",
+              f"A toss: the measured means differ by less than {TOSS_SE:g} combined standard errors.", "",
+              "| payload | orientation | measured | predicted | right |", "|---|---|---|---|---|"]
+    for o in s["orders"]:
+        toss = " (a toss)" if o["measured_toss"] else ""
+        lines.append(f"| {o['payload_g']:g} g | {o['orientation']} | {CONTROLLER_LABELS[o['measured_better']]}{toss} | "
+                     f"{CONTROLLER_LABELS[o['predicted_better']]} | {yes[o['right']]} |")
+    c = s["conclusions"]
+    lines += ["", "## The thesis's three robustness conclusions, measured and predicted", ""]
+    stalled = c[2]["stalled"]
+    stalls = (f"; stalled runs at 13.5 g vertical: predicted {stalled['predicted']}, measured "
+              f"{'not given' if stalled['measured'] is None else stalled['measured']}")
+    for number, text, more in ((1, "13.5 g horizontal over 0 g horizontal", ""),
+                               (2, "13.5 g vertical over 0 g vertical", stalls)):
+        parts = [f"{CONTROLLER_LABELS[name]} measured x{c[number][name]['measured']:.2f}, predicted "
+                 f"x{c[number][name]['predicted']:.2f} ({'agrees' if c[number][name]['agree'] else 'does not agree'}"
+                 f" within 20 %)" for name in ("ffpva", "smc")]
+        lines.append(f"{number}. *{text}*: " + "; ".join(parts) + more + ".")
+    lines.append(f"3. *Sliding mode tracks better than FF + PVA*: in {c[3]['measured']} of {c[3]['of']} pairs "
+                 f"measured, {c[3]['predicted']} predicted.")
+    return "\n".join(lines) + "\n"
+
+
+def figure(s: dict, path: pathlib.Path) -> None:
+    """Each cell: the members' range (thin), the 10-90 % band (thick), the committed mean (dot) and the
+    measured mean with two standard errors."""
+    from viz.figures import finish, plt
+
+    cells = s["cells"]
+    x = np.arange(len(cells))
+    fig, ax = plt.subplots(figsize=(9, 4.2))
+    ax.vlines(x, [r["member_low"] for r in cells], [r["member_high"] for r in cells], color="tab:blue", lw=1,
+              label="members' range")
+    ax.vlines(x, [r["band_p10"] for r in cells], [r["band_p90"] for r in cells], color="tab:blue", lw=6, alpha=0.4,
+              label="10-90 % band")
+    ax.plot(x, [r["twin_mean"] for r in cells], "o", color="tab:blue", label="committed preset")
+    ax.errorbar(x + 0.18, [r["measured"] for r in cells],
+                yerr=[2 * r["measured_std"] / math.sqrt(r["runs"]) for r in cells], fmt="s", color="black",
+                capsize=3, label="measured ± 2 SE")
+    ax.set_xticks(x, [f"{'FF+PVA' if r['controller'] == 'ffpva' else 'SMC'}\n{r['payload_g']:g} g "
+                      f"{r['orientation'][0].upper()}" for r in cells], fontsize=8)
+    ax.set_title("Blind T3 prediction against the measurements")
+    fig.subplots_adjust(bottom=0.2)  # room for the two-line cell names and the axis label
+    finish(fig, ax, path, xlabel="T3 cell", ylabel="RMSE (deg)")
+
+
+class ScoreExperiment(Experiment):
+    name = "score"
+    help = "the blind T3 prediction against measured T3 cells, by rules fixed before the data"
+
+    def add_arguments(self, parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--measured", type=pathlib.Path, required=True, metavar="FILE",
+                            help="CSV of the measured T3 cells: " + ", ".join(MEASURED_COLUMNS) +
+                                 " (optional: trajectory, runs, stalled_runs)")
+        parser.add_argument("--prediction", type=pathlib.Path, default=None, metavar="DIR",
+                            help="a twin validate --out folder (default: the committed prediction)")
+
+    def check(self, args: argparse.Namespace) -> None:
+        read_measured(args.measured)
+        read_prediction(args.prediction)
+
+    def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
+        s = score(read_measured(args.measured), read_prediction(args.prediction))
+        s["report"] = report(s, measured=f"`{args.measured}`",
+                             prediction="the committed one" if args.prediction is None else f"`{args.prediction}`")
+        return Outcome(rows=s["cells"], answer=answer(s), detail=s)
+
+    def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
+        """``score.csv`` (per cell), ``orders.csv``, ``score.md`` and ``score.png``."""
+        s = outcome.detail
+        paths = [out / "score.csv", out / "orders.csv", out / "score.md"]
+        write_csv(s["cells"], SCORE_COLUMNS, paths[0])
+        write_csv(s["orders"], ORDER_COLUMNS, paths[1])
+        paths[2].write_text(s["report"], encoding="utf-8")
+        return paths + drawn(lambda path: figure(s, path), out / "score.png", undrawn)
+
+
+EXPERIMENT = ScoreExperiment()
