@@ -31,13 +31,13 @@ def made_up(mean=lambda c, g, o: 1.0, std=0.1) -> list[dict]:
 
 
 def predicted(mean=lambda c, g, o: 1.0, members=(0.9, 1.0, 1.1), stalled=0) -> dict:
-    return {k: {"mean": mean(*k), "p10": min(members) + 0.02, "p90": max(members) - 0.02, "stalled": stalled,
-                "members": [mean(*k) * m for m in members]} for k in CELLS}
+    return {k: {"mean": mean(*k), "p10": mean(*k) * (min(members) + 0.02), "p90": mean(*k) * (max(members) - 0.02),
+                "stalled": stalled, "runs": 5 * len(members), "members": [mean(*k) * m for m in members]} for k in CELLS}
 
 
-def measured_of(rows: list[dict], runs: int = 5) -> dict:
+def measured_of(rows: list[dict], runs: int = 5, stalled=None) -> dict:
     return {(r["controller"], float(r["payload_g"]), r["orientation"]): {
-        "mean": float(r["rmse_mean_deg"]), "std": float(r["rmse_std_deg"]), "runs": runs, "stalled": None}
+        "mean": float(r["rmse_mean_deg"]), "std": float(r["rmse_std_deg"]), "runs": runs, "stalled": stalled}
         for r in rows}
 
 
@@ -53,6 +53,10 @@ def test_each_cell_is_judged_by_the_ratio_the_band_the_members_and_the_standard_
     m = measured_of(made_up(mean=lambda c, g, o: 1.09))
     r = score.score(m, predicted())["cells"][0]
     assert r["in_members"] and not r["in_band"] and r["within"]
+    assert (r["band_p10"], r["band_p90"], r["member_low"], r["member_high"]) == pytest.approx((0.92, 1.08, 0.9, 1.1))
+    # With no spread measured, any difference is infinitely many standard errors, and none is none.
+    exact = score.score(measured_of(made_up(std=0.0)), predicted(mean=lambda c, g, o: 1.0 + 0.1 * (c == "smc")))
+    assert [r["z"] for r in exact["cells"]] == [0.0] * 6 + [math.inf] * 6
     # 20 % either way, as every measured RMSE in twin validate.
     assert [score.score(measured_of(made_up(mean=lambda c, g, o, x=x: x)), predicted())["cells"][0]["within"]
             for x in (1 / 1.19, 1 / 1.21, 1 / 0.81, 1 / 0.79)] == [True, False, True, False]
@@ -66,6 +70,21 @@ def test_the_order_is_right_when_the_better_controller_agrees_and_a_toss_is_name
                for o in s["orders"])
     assert [o["measured_toss"] for o in s["orders"]] == [o == "vertical" for _, _, o in CELLS[:6]]
     assert s["conclusions"][3] == {"measured": 6, "predicted": 0, "of": 6}
+    # Equal measured means favour neither law: not counted right for either prediction, and a toss.
+    s = score.score(measured_of(made_up(std=0.0)), predicted(mean=lambda c, g, o: 1.0 + 0.1 * (c == "smc")))
+    assert all(o["measured_better"] == score.TIE and o["measured_toss"] and not o["right"] for o in s["orders"])
+    assert "| 0 g | horizontal | neither (equal means) (a toss) | FF + PVA | no |" in score.report(s, prediction="",
+                                                                                             measured="")
+
+
+@pytest.mark.parametrize("margin,toss", [(1.5, True), (2.5, False)])
+def test_a_toss_is_a_difference_under_two_combined_standard_errors(margin, toss):
+    # Unequal spreads: FF + PVA std 0.3, sliding mode 0.4, five runs each: combined SE = hypot(0.3, 0.4) / sqrt 5.
+    combined = math.hypot(0.3, 0.4) / math.sqrt(5)
+    rows = [{**r, "rmse_std_deg": 0.3 if r["controller"] == "ffpva" else 0.4,
+             "rmse_mean_deg": 2.0 - margin * combined * (r["controller"] == "smc")} for r in made_up()]
+    orders = score.score(measured_of(rows), predicted())["orders"]
+    assert {o["measured_toss"] for o in orders} == {toss} and {o["measured_better"] for o in orders} == {"smc"}
 
 
 def test_the_conclusions_compare_the_payloads_costs_and_count_the_stalls():
@@ -74,10 +93,13 @@ def test_the_conclusions_compare_the_payloads_costs_and_count_the_stalls():
     c = s["conclusions"]
     assert c[1]["ffpva"] == {"measured": 1.5, "predicted": 1.0, "agree": False}
     assert c[2]["smc"] == {"measured": 3.0, "predicted": 2.0, "agree": False}
-    assert c[2]["stalled"] == {"predicted": 2, "measured": None}
+    assert c[2]["stalled"] == {"predicted": 2, "predicted_runs": 30, "measured": None, "measured_runs": 10}
     text = score.report(s, prediction="made up", measured="made up")
     assert "1. *13.5 g horizontal over 0 g horizontal*: FF + PVA measured x1.50, predicted x1.00 (does not agree" in text
-    assert "stalled runs at 13.5 g vertical: predicted 2, measured not given." in text
+    assert "stalled runs at 13.5 g vertical: predicted 2 of 30 (every member's), measured not given." in text
+    s = score.score(measured_of(made_up(), runs=4, stalled=1), predicted())
+    assert s["conclusions"][2]["stalled"] == {"predicted": 0, "predicted_runs": 30, "measured": 2, "measured_runs": 8}
+    assert "measured 2 of 8." in score.report(s, prediction="", measured="")
 
 
 def test_score_writes_its_tables_report_and_figure_against_the_committed_prediction(tmp_path):
@@ -103,10 +125,17 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     (lambda rows: [{**rows[0], "controller": "pva"}, *rows[1:]], "line 2: controller must be ffpva or smc"),
     (lambda rows: [{**rows[0], "payload_g": "5"}, *rows[1:]], "line 2: no T3 cell FF + PVA 5 g horizontal"),
     (lambda rows: [{**rows[0], "rmse_std_deg": "-1"}, *rows[1:]], "line 2: rmse_std_deg must be a number of at least 0"),
-    (lambda rows: [{**rows[0], "rmse_mean_deg": "nan"}, *rows[1:]], "line 2: rmse_mean_deg must be a positive number"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "nan"}, *rows[1:]], "line 2: rmse_mean_deg must be a number of at least 0.01"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "1e-320"}, *rows[1:]], "line 2: rmse_mean_deg must be a number of at"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "1_3"}, *rows[1:]], "line 2: rmse_mean_deg must be a number of at"),
+    (lambda rows: [{**rows[0], "runs": "1"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000, got '1'"),
+    (lambda rows: [{**rows[0], "runs": "\u00b2"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000"),
+    (lambda rows: [{**rows[0], "stalled_runs": "6"}, *rows[1:]], "line 2: stalled_runs must be a whole number from 0 to 5"),
+    (lambda rows: [{**rows[0], "trajectory": "1"}, *rows[1:]], "line 2: only the T3 cells are scored, got trajectory '1'"),
 ])
 def test_bad_measurements_are_a_one_line_error_and_nothing_is_written(tmp_path, capsys, edit, message):
-    measured = write_measured(tmp_path / "t3.csv", edit(made_up()))
+    measured = write_measured(tmp_path / "t3.csv", edit(made_up()),
+                              columns=(*score.MEASURED_COLUMNS, "trajectory", "runs", "stalled_runs"))
     out = tmp_path / "s"
     assert main(["score", "--measured", str(measured), "--out", str(out)]) == 2
     err = capsys.readouterr().err
@@ -114,20 +143,49 @@ def test_bad_measurements_are_a_one_line_error_and_nothing_is_written(tmp_path, 
     assert not out.exists()
 
 
-def test_missing_inputs_and_columns_are_one_line_errors(tmp_path, capsys):
+def test_missing_inputs_and_malformed_files_are_one_line_errors(tmp_path, capsys):
     out = tmp_path / "s"
-    assert main(["score", "--measured", str(tmp_path / "none.csv"), "--out", str(out)]) == 2
-    assert "measured file" in capsys.readouterr().err and not out.exists()
-    lacking = write_measured(tmp_path / "t3.csv", made_up(), columns=score.MEASURED_COLUMNS[:-1])
-    assert main(["score", "--measured", str(lacking), "--out", str(out)]) == 2
-    assert "lacks the column(s) rmse_std_deg" in capsys.readouterr().err
     good = write_measured(tmp_path / "good.csv", made_up())
+    text = good.read_text()
+    header, first, *rest = text.splitlines(keepends=True)
+    cases = {
+        "none.csv": (None, "measured file"),
+        "lacking.csv": ("".join(line.rsplit(",", 1)[0] + "\n" for line in text.splitlines()),
+                        "lacks the column(s) rmse_std_deg"),
+        "semicolons.csv": (text.replace(",", ";"), "its fields must be separated by commas"),
+        "longer.csv": (header + first.rstrip("\n") + ",9\n" + "".join(rest), "line 2 has more fields than its header"),
+        "repeated.csv": (header.rstrip("\n") + ",rmse_mean_deg\n" + "".join(line.rstrip("\n") + ",99\n"
+                                                                               for line in [first, *rest]),
+                         "names the column(s) rmse_mean_deg more than once"),
+    }
+    for name, (content, message) in cases.items():
+        if content is not None:
+            (tmp_path / name).write_text(content)
+        assert main(["score", "--measured", str(tmp_path / name), "--out", str(out)]) == 2, name
+        err = capsys.readouterr().err
+        assert message in err and err.count("\n") == 1 and not out.exists(), (name, err)
     assert main(["score", "--measured", str(good), "--prediction", str(tmp_path), "--out", str(out)]) == 2
-    assert "does not exist" in capsys.readouterr().err and not out.exists()
-    runs = write_measured(tmp_path / "runs.csv", [{**r, "runs": 1} for r in made_up()],
-                          columns=(*score.MEASURED_COLUMNS, "runs"))
-    assert main(["score", "--measured", str(runs), "--out", str(out)]) == 2
-    assert "runs must be a whole number of at least 2" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "does not exist" in err and err.count("\n") == 1 and not out.exists()
+
+
+def test_a_spreadsheets_file_is_read_as_written(tmp_path):
+    """Labels in any case, capitals, a payload written 6.50, blank lines between rows and a byte-order mark:
+    the same cells as the plain file, each error's line the file's own."""
+    rows = made_up(mean=lambda c, g, o: 1.0 + g / 10)
+    plain = score.read_measured(write_measured(tmp_path / "plain.csv", rows))
+    labels = {"ffpva": "FF + PVA", "smc": "Sliding Mode"}
+    lines = ["controller,payload_g,orientation,rmse_mean_deg,rmse_std_deg"] + [
+        f"{labels[r['controller']]},{r['payload_g']:.2f},{r['orientation'].capitalize()},{r['rmse_mean_deg']},"
+        f"{r['rmse_std_deg']}\n" for r in rows]
+    spreadsheet = tmp_path / "sheet.csv"
+    spreadsheet.write_text("\ufeff" + "\n".join(lines), encoding="utf-8")
+    assert score.read_measured(spreadsheet) == plain
+    fields = lines[3].split(",")
+    bad = ",".join([*fields[:3], "x", *fields[4:]])
+    spreadsheet.write_text("\n".join([*lines[:3], bad, *lines[4:]]), encoding="utf-8")
+    with pytest.raises(score.InvalidScenario, match="sheet.csv line 6: rmse_mean_deg"):
+        score.read_measured(spreadsheet)  # the blank lines after rows 2 and 3 counted
 
 
 def test_a_validate_folder_can_be_scored_in_place_of_the_committed_prediction(tmp_path):
@@ -145,6 +203,19 @@ def test_a_validate_folder_can_be_scored_in_place_of_the_committed_prediction(tm
     assert p["smc", 13.5, "vertical"]["members"] == [1.8, 2.0, 2.2]
     s = score.score(measured_of(made_up(mean=lambda c, g, o: 2.0)), p)
     assert all(r["within"] and r["in_band"] and r["in_members"] for r in s["cells"])
+    assert p["ffpva", 0.0, "horizontal"]["runs"] == 15  # three members' five runs
+    # A broken folder is a one-line error, not a score.
+    cells, members = (folder / "prediction.csv").read_text(), (folder / "prediction_members.csv").read_text()
+    for name, content, message in (
+            ("prediction.csv", cells.replace(",2.0,1.9,", ",nan,1.9,", 1), "twin_mean must be a number"),
+            ("prediction_members.csv", members.replace(",1,", ",0,", 1), "member 0 of the cell is given twice"),
+            ("prediction_members.csv", "".join(members.splitlines(keepends=True)[:-1]),
+             "does not give every T3 cell the same members")):
+        (folder / name).write_text(content)
+        with pytest.raises(score.InvalidScenario, match=message):
+            score.read_prediction(folder)
+        (folder / "prediction.csv").write_text(cells)
+        (folder / "prediction_members.csv").write_text(members)
 
 
 def test_the_committed_prediction_is_the_current_table_of_docs_prediction_md():

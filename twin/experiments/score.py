@@ -21,8 +21,8 @@ The rules (:func:`score`). Changing one after a measurement has been seen is a n
   mean); ``z``, the committed mean's distance from the measured mean in the measured mean's standard errors
   (std / sqrt(runs)).
 * Per payload and orientation: which controller tracked better, measured and predicted (the committed
-  means); the measured order is **a toss** when the two measured means differ by less than two combined
-  standard errors.
+  means), or neither when the two means are equal; the measured order is **a toss** when the two measured
+  means differ by less than two combined standard errors (or are equal). Right: the same answer.
 * The thesis's three robustness conclusions, on T3, measured and predicted: (1) the cost of 13.5 g
   horizontal, 13.5 g over 0 g horizontal, per controller; (2) the cost of 13.5 g vertical, 13.5 g over 0 g
   vertical, per controller, and the stalled runs; (3) in how many of the six payload-and-orientation pairs
@@ -51,6 +51,7 @@ from twin.experiments.validate import (
     RMSE_TOLERANCE,
     rmse_within,
 )
+from twin.experiments.validate import SEEDS as VALIDATE_SEEDS
 from twin.sim.scenario import CONTROLLER_LABELS
 
 COMMITTED = importlib.resources.files("twin.experiments") / "data"  # package data
@@ -59,6 +60,8 @@ VALIDATE_FILES = ("prediction.csv", "prediction_members.csv")  # the same two, a
 RULES_WRITTEN = "2026-11-26"  # before any T3 measurement was seen
 MEASURED_COLUMNS = ("controller", "payload_g", "orientation", "rmse_mean_deg", "rmse_std_deg")
 OPTIONAL_COLUMNS = {"trajectory": 3, "runs": 5, "stalled_runs": None}  # and their values when left out
+TIE = "tie"  # the two means equal: neither tracked better (and the order is a toss)
+ORDER_LABELS = {**CONTROLLER_LABELS, TIE: "neither (equal means)"}
 TOSS_SE = 2.0  # measured means closer than this many combined standard errors: the order is a toss
 SCORE_COLUMNS = ("controller", "payload_g", "orientation", "measured", "measured_std", "runs", "twin_mean",
                  "band_p10", "band_p90", "member_low", "member_high", "ratio", "within", "in_band", "in_members", "z")
@@ -68,29 +71,54 @@ CONTROLLER_NAMES = {**{name: name for name in CONTROLLER_LABELS}, **{label.lower
 CELL_KEYS = tuple((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # (controller, payload g, orientation)
 
 
-def _read(path: pathlib.Path, what: str) -> tuple[list[str], list[dict]]:
+MAX_RUNS = 1000  # runs per measured cell: more is a typing error, not a rig's day
+SMALLEST_MEAN_DEG = 0.01  # a measured RMSE mean below this is no measurement (the Hall sensor's noise is 0.24 deg)
+
+
+def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
+    """A CSV's column names and its rows, each with the line it ends on; blank rows left out. One-line
+    :class:`InvalidScenario` errors for a file that cannot be read, a repeated column name or a row with more
+    fields than the header. ``path`` may be a package resource."""
     try:
-        with open(path, newline="", encoding="utf-8") as handle:
+        with importlib.resources.as_file(path) as real, open(real, newline="", encoding="utf-8-sig") as handle:
             reader = csv.DictReader(handle)
-            return [c.strip() for c in reader.fieldnames or []], [{k.strip(): (v or "").strip() for k, v in row.items()
-                                                                   if k is not None} for row in reader]
+            columns = [c.strip() for c in reader.fieldnames or []]
+            repeated = sorted({c for c in columns if columns.count(c) > 1})
+            if repeated:
+                raise InvalidScenario(f"{what} {str(path)!r} names the column(s) {', '.join(repeated)} more than once")
+            rows = []
+            for row in reader:
+                if None in row:
+                    raise InvalidScenario(f"{what} {str(path)!r} line {reader.line_num} has more fields than its header")
+                cells = {k.strip(): (v or "").strip() for k, v in row.items()}
+                if any(cells.values()):
+                    rows.append((reader.line_num, cells))
+            return columns, rows
     except FileNotFoundError:
         raise InvalidScenario(f"{what} {str(path)!r} does not exist") from None
     except IsADirectoryError:
         raise InvalidScenario(f"{what} {str(path)!r} is a folder, not a CSV file") from None
     except (OSError, UnicodeDecodeError, csv.Error) as error:
-        raise InvalidScenario(f"cannot read {what} {str(path)!r}: {error}") from None
+        raise InvalidScenario(f"cannot read {what} {str(path)!r}: {error}".splitlines()[0]) from None
 
 
-def _number(text: str, where: str, column: str, *, low: float = 0.0, positive: bool = False) -> float:
+def _number(text: str, where: str, column: str, *, low: float = 0.0, above: bool = False) -> float:
+    """``text`` as a finite number of at least ``low`` (above it when ``above``), else a one-line error."""
     try:
-        value = float(text)
+        value = float(text) if "_" not in text else math.nan
     except ValueError:
         value = math.nan
-    if not math.isfinite(value) or value < low or (positive and value <= 0):
-        need = "a positive number" if positive else f"a number of at least {low:g}"
+    if not math.isfinite(value) or value < low or (above and value <= low):
+        need = f"a number above {low:g}" if above else f"a number of at least {low:g}"
         raise InvalidScenario(f"{where}: {column} must be {need}, got {text!r}")
     return value
+
+
+def _whole(text: str, where: str, column: str, low: int, high: int) -> int:
+    """``text`` as a whole number from ``low`` to ``high``, else a one-line error."""
+    if not (text.isascii() and text.isdigit()) or not low <= int(text) <= high:
+        raise InvalidScenario(f"{where}: {column} must be a whole number from {low} to {high}, got {text!r}")
+    return int(text)
 
 
 def _cell_key(row: dict, where: str) -> tuple[str, float, str]:
@@ -104,6 +132,8 @@ def _cell_key(row: dict, where: str) -> tuple[str, float, str]:
     if key not in CELL_KEYS:
         raise InvalidScenario(f"{where}: no T3 cell {CONTROLLER_LABELS[name]} {row['payload_g']} g {row['orientation']}"
                               f" (payloads 0, 6.5, 13.5 g; horizontal or vertical)")
+    if row.get("trajectory", "3") not in ("", "3"):
+        raise InvalidScenario(f"{where}: only the T3 cells are scored, got trajectory {row['trajectory']!r}")
     return key
 
 
@@ -120,27 +150,20 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
     columns, rows = _read(path, "measured file")
     lacking = [c for c in MEASURED_COLUMNS if c not in columns]
     if lacking:
+        hint = " (its fields must be separated by commas)" if any(";" in c or "\t" in c for c in columns) else ""
         raise InvalidScenario(f"measured file {str(path)!r} lacks the column(s) {', '.join(lacking)} "
-                              f"(it needs {', '.join(MEASURED_COLUMNS)})")
+                              f"(it needs {', '.join(MEASURED_COLUMNS)}){hint}")
     found: dict[tuple, dict] = {}
-    for line, row in enumerate(rows, start=2):
+    for line, row in rows:
         where = f"{path.name} line {line}"
-        if not any(row.values()):
-            continue
         key = _cell_key(row, where)
         if key in found:
             raise InvalidScenario(f"{where}: {CONTROLLER_LABELS[key[0]]} {key[1]:g} g {key[2]} is given twice")
-        if row.get("trajectory", "3") not in ("", "3"):
-            raise InvalidScenario(f"{where}: only the T3 cells are scored, got trajectory {row['trajectory']!r}")
-        runs = row.get("runs") or str(OPTIONAL_COLUMNS["runs"])
-        if not runs.isdigit() or int(runs) < 2:
-            raise InvalidScenario(f"{where}: runs must be a whole number of at least 2, got {runs!r}")
+        runs = _whole(row.get("runs") or str(OPTIONAL_COLUMNS["runs"]), where, "runs", 2, MAX_RUNS)
         stalled = row.get("stalled_runs") or None
-        if stalled is not None and (not stalled.isdigit() or int(stalled) > int(runs)):
-            raise InvalidScenario(f"{where}: stalled_runs must be a whole number up to runs, got {stalled!r}")
-        found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", positive=True),
-                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg"), "runs": int(runs),
-                      "stalled": None if stalled is None else int(stalled)}
+        found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG),
+                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg"), "runs": runs,
+                      "stalled": None if stalled is None else _whole(stalled, where, "stalled_runs", 0, runs)}
     _complete(found, f"measured file {str(path)!r}")
     return found
 
@@ -156,25 +179,38 @@ def prediction_files(folder: pathlib.Path | None) -> tuple:
 
 def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
     """The prediction by (controller, payload g, orientation): the committed mean, the 10-90 % band, every
-    member's mean and the stalled runs."""
+    member's mean, the stalled runs and the runs they are of (every member's)."""
     cells_path, members_path = prediction_files(folder)
     columns, rows = _read(cells_path, "prediction file")
     member_columns, member_rows = _read(members_path, "prediction file")
     if columns != list(PREDICTION_COLUMNS) or member_columns != list(PREDICTION_MEMBER_COLUMNS):
         raise InvalidScenario(f"{str(cells_path)!r} and {str(members_path)!r} are not twin validate's prediction files")
     found: dict[tuple, dict] = {}
-    try:
-        for row in rows:
-            key = _cell_key(row, cells_path.name)
-            found[key] = {"mean": float(row["twin_mean"]), "p10": float(row["band_p10"]),
-                          "p90": float(row["band_p90"]), "stalled": int(row["stalled_runs"]), "members": []}
-        for row in member_rows:
-            found[_cell_key(row, members_path.name)]["members"].append(float(row["twin_mean"]))
-    except (KeyError, ValueError) as error:
-        raise InvalidScenario(f"cannot read the prediction in {str(cells_path.parent)!r}: {error}") from None
+    for line, row in rows:
+        where = f"{cells_path.name} line {line}"
+        key = _cell_key(row, where)
+        if key in found:
+            raise InvalidScenario(f"{where}: the cell is given twice")
+        found[key] = {**{name: _number(row[column], where, column, low=-math.inf) for name, column in (
+            ("mean", "twin_mean"), ("p10", "band_p10"), ("p90", "band_p90"))},
+            "stalled": _whole(row["stalled_runs"], where, "stalled_runs", 0, 10**9), "members": {}}
+    for line, row in member_rows:
+        where = f"{members_path.name} line {line}"
+        key, member = _cell_key(row, where), _whole(row["member"], where, "member", 0, 10**6)
+        if key not in found:
+            raise InvalidScenario(f"{where}: {CONTROLLER_LABELS[key[0]]} {key[1]:g} g {key[2]} is not in "
+                                  f"{cells_path.name}")
+        members = found[key]["members"]
+        if member in members:
+            raise InvalidScenario(f"{where}: member {member} of the cell is given twice")
+        members[member] = _number(row["twin_mean"], where, "twin_mean", low=-math.inf)
     _complete(found, f"prediction {str(cells_path.parent)!r}")
-    if any(not cell["members"] for cell in found.values()):
-        raise InvalidScenario(f"{str(members_path)!r} lacks the members of some T3 cell")
+    counts = {len(cell["members"]) for cell in found.values()}
+    if len(counts) != 1 or 0 in counts:
+        raise InvalidScenario(f"{str(members_path)!r} does not give every T3 cell the same members")
+    for cell in found.values():
+        cell["members"] = [cell["members"][k] for k in sorted(cell["members"])]
+        cell["runs"] = len(cell["members"]) * len(VALIDATE_SEEDS)
     return found
 
 
@@ -187,6 +223,11 @@ def _in_standard_errors(difference: float, se: float) -> float:
     if se > 0:
         return difference / se
     return math.copysign(math.inf, difference) if difference else 0.0
+
+
+def _better(ffpva: float, smc: float) -> str:
+    """Which controller tracked better (the lower RMSE), or :data:`TIE`."""
+    return "smc" if smc < ffpva else "ffpva" if ffpva < smc else TIE
 
 
 def score(measured: dict[tuple, dict], predicted: dict[tuple, dict]) -> dict:
@@ -208,11 +249,11 @@ def score(measured: dict[tuple, dict], predicted: dict[tuple, dict]) -> dict:
     for payload_g, orientation in dict.fromkeys((g, o) for _, g, o in CELL_KEYS):
         ff, smc = measured["ffpva", payload_g, orientation], measured["smc", payload_g, orientation]
         combined = math.hypot(ff["std"] / math.sqrt(ff["runs"]), smc["std"] / math.sqrt(smc["runs"]))
-        better = "smc" if smc["mean"] < ff["mean"] else "ffpva"
-        twin_better = "smc" if predicted["smc", payload_g, orientation]["mean"] < \
-            predicted["ffpva", payload_g, orientation]["mean"] else "ffpva"
+        better = _better(ff["mean"], smc["mean"])
+        twin_better = _better(predicted["ffpva", payload_g, orientation]["mean"],
+                              predicted["smc", payload_g, orientation]["mean"])
         orders.append({"payload_g": payload_g, "orientation": orientation, "measured_better": better,
-                       "measured_toss": abs(smc["mean"] - ff["mean"]) < TOSS_SE * combined,
+                       "measured_toss": better == TIE or abs(smc["mean"] - ff["mean"]) < TOSS_SE * combined,
                        "predicted_better": twin_better, "right": better == twin_better})
     conclusions = {}
     for number, orientation in ((1, "horizontal"), (2, "vertical")):
@@ -221,9 +262,12 @@ def score(measured: dict[tuple, dict], predicted: dict[tuple, dict]) -> dict:
                                for c in ("ffpva", "smc")}
         for both in conclusions[number].values():
             both["agree"] = bool(rmse_within(both["predicted"], both["measured"]))
-    stalled = [measured[k]["stalled"] for k in CELL_KEYS if k[1:] == (13.5, "vertical")]
-    conclusions[2]["stalled"] = {"predicted": sum(predicted[k]["stalled"] for k in CELL_KEYS if k[1:] == (13.5, "vertical")),
-                                 "measured": None if None in stalled else sum(stalled)}
+    heavy = [k for k in CELL_KEYS if k[1:] == (13.5, "vertical")]
+    stalled = [measured[k]["stalled"] for k in heavy]
+    conclusions[2]["stalled"] = {"predicted": sum(predicted[k]["stalled"] for k in heavy),
+                                 "predicted_runs": sum(predicted[k]["runs"] for k in heavy),
+                                 "measured": None if None in stalled else sum(stalled),
+                                 "measured_runs": sum(measured[k]["runs"] for k in heavy)}
     conclusions[3] = {"measured": sum(o["measured_better"] == "smc" for o in orders),
                       "predicted": sum(o["predicted_better"] == "smc" for o in orders), "of": len(orders)}
     return {"cells": cells, "orders": orders, "conclusions": conclusions}
@@ -275,13 +319,15 @@ def report(s: dict, *, prediction: str, measured: str) -> str:
               "| payload | orientation | measured | predicted | right |", "|---|---|---|---|---|"]
     for o in s["orders"]:
         toss = " (a toss)" if o["measured_toss"] else ""
-        lines.append(f"| {o['payload_g']:g} g | {o['orientation']} | {CONTROLLER_LABELS[o['measured_better']]}{toss} | "
-                     f"{CONTROLLER_LABELS[o['predicted_better']]} | {yes[o['right']]} |")
+        lines.append(f"| {o['payload_g']:g} g | {o['orientation']} | {ORDER_LABELS[o['measured_better']]}{toss} | "
+                     f"{ORDER_LABELS[o['predicted_better']]} | {yes[o['right']]} |")
     c = s["conclusions"]
     lines += ["", "## The thesis's three robustness conclusions, measured and predicted", ""]
     stalled = c[2]["stalled"]
-    stalls = (f"; stalled runs at 13.5 g vertical: predicted {stalled['predicted']}, measured "
-              f"{'not given' if stalled['measured'] is None else stalled['measured']}")
+    measured_stalls = ("not given" if stalled["measured"] is None else
+                       f"{stalled['measured']} of {stalled['measured_runs']}")
+    stalls = (f"; stalled runs at 13.5 g vertical: predicted {stalled['predicted']} of {stalled['predicted_runs']} "
+              f"(every member's), measured {measured_stalls}")
     for number, text, more in ((1, "13.5 g horizontal over 0 g horizontal", ""),
                                (2, "13.5 g vertical over 0 g vertical", stalls)):
         parts = [f"{CONTROLLER_LABELS[name]} measured x{c[number][name]['measured']:.2f}, predicted "
