@@ -115,6 +115,9 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     assert (out / "score.png").read_bytes().startswith(b"\x89PNG")
     text = (out / "score.md").read_text(encoding="utf-8")
     assert "6 of 12 T3 cells within 20 %" in text and "before any T3 measurement was seen" in text
+    from twin.plants.as_built import preset_digest
+
+    assert f"Prediction: the committed one, `twin validate` on as-built preset {preset_digest()}." in text
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["orders.csv", "score.csv", "score.md",
                                                                                     "score.png"]
 

@@ -362,6 +362,13 @@ def figure(s: dict, path: pathlib.Path) -> None:
     finish(fig, ax, path, xlabel="T3 cell", ylabel="RMSE (deg)")
 
 
+def committed_name() -> str:
+    """How ``score.md`` names the committed prediction: with the preset it was run on."""
+    from twin.plants.as_built import preset_digest
+
+    return f"the committed one, `twin validate` on as-built preset {preset_digest()}"
+
+
 class ScoreExperiment(Experiment):
     name = "score"
     help = "the blind T3 prediction against measured T3 cells, by rules fixed before the data"
@@ -380,7 +387,7 @@ class ScoreExperiment(Experiment):
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         s = score(read_measured(args.measured), read_prediction(args.prediction))
         s["report"] = report(s, measured=f"`{args.measured}`",
-                             prediction="the committed one" if args.prediction is None else f"`{args.prediction}`")
+                             prediction=committed_name() if args.prediction is None else f"`{args.prediction}`")
         return Outcome(rows=s["cells"], answer=answer(s), detail=s)
 
     def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
