@@ -214,8 +214,9 @@ def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
     return found
 
 
-def _cost(cells: dict, controller: str, payload_g: float, orientation: str, key: str) -> float:
-    return cells[controller, payload_g, orientation][key] / cells[controller, 0.0, orientation][key]
+def _cost(cells: dict, controller: str, payload_g: float, orientation: str) -> float:
+    """What a payload costs a controller: its cell's mean over the same controller's 0 g cell, same side."""
+    return cells[controller, payload_g, orientation]["mean"] / cells[controller, 0.0, orientation]["mean"]
 
 
 def _in_standard_errors(difference: float, se: float) -> float:
@@ -257,8 +258,8 @@ def score(measured: dict[tuple, dict], predicted: dict[tuple, dict]) -> dict:
                        "predicted_better": twin_better, "right": better == twin_better})
     conclusions = {}
     for number, orientation in ((1, "horizontal"), (2, "vertical")):
-        conclusions[number] = {c: {"measured": _cost(measured, c, 13.5, orientation, "mean"),
-                                   "predicted": _cost(predicted, c, 13.5, orientation, "mean")}
+        conclusions[number] = {c: {"measured": _cost(measured, c, 13.5, orientation),
+                                   "predicted": _cost(predicted, c, 13.5, orientation)}
                                for c in ("ffpva", "smc")}
         for both in conclusions[number].values():
             both["agree"] = bool(rmse_within(both["predicted"], both["measured"]))
