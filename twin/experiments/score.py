@@ -137,6 +137,16 @@ def _cell_key(row: dict, where: str) -> tuple[str, float, str]:
     return key
 
 
+def _each_cell(rows: list[tuple[int, dict]], path, found: dict):
+    """(where, cell key, row) for each of ``_read``'s rows, refusing a cell already in ``found``."""
+    for line, row in rows:
+        where = f"{path.name} line {line}"
+        key = _cell_key(row, where)
+        if key in found:
+            raise InvalidScenario(f"{where}: {CONTROLLER_LABELS[key[0]]} {key[1]:g} g {key[2]} is given twice")
+        yield where, key, row
+
+
 def _complete(found: dict, what: str) -> None:
     missing = [k for k in CELL_KEYS if k not in found]
     if missing:
@@ -154,11 +164,7 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
         raise InvalidScenario(f"measured file {str(path)!r} lacks the column(s) {', '.join(lacking)} "
                               f"(it needs {', '.join(MEASURED_COLUMNS)}){hint}")
     found: dict[tuple, dict] = {}
-    for line, row in rows:
-        where = f"{path.name} line {line}"
-        key = _cell_key(row, where)
-        if key in found:
-            raise InvalidScenario(f"{where}: {CONTROLLER_LABELS[key[0]]} {key[1]:g} g {key[2]} is given twice")
+    for where, key, row in _each_cell(rows, path, found):
         runs = _whole(row.get("runs") or str(OPTIONAL_COLUMNS["runs"]), where, "runs", 2, MAX_RUNS)
         stalled = row.get("stalled_runs") or None
         found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG),
@@ -186,11 +192,7 @@ def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
     if columns != list(PREDICTION_COLUMNS) or member_columns != list(PREDICTION_MEMBER_COLUMNS):
         raise InvalidScenario(f"{str(cells_path)!r} and {str(members_path)!r} are not twin validate's prediction files")
     found: dict[tuple, dict] = {}
-    for line, row in rows:
-        where = f"{cells_path.name} line {line}"
-        key = _cell_key(row, where)
-        if key in found:
-            raise InvalidScenario(f"{where}: the cell is given twice")
+    for where, key, row in _each_cell(rows, cells_path, found):
         found[key] = {**{name: _number(row[column], where, column, low=-math.inf) for name, column in (
             ("mean", "twin_mean"), ("p10", "band_p10"), ("p90", "band_p90"))},
             "stalled": _whole(row["stalled_runs"], where, "stalled_runs", 0, 10**9), "members": {}}
