@@ -12,7 +12,7 @@ import sys
 import numpy as np
 import pytest
 
-from twin.experiments import validate
+from twin.experiments import score, validate
 from twin.experiments.reference import THESIS_PAYLOADS_G
 from twin.plants.as_built import ensemble_values
 
@@ -105,9 +105,8 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
     # The prediction `twin score` holds against measurements by default is this run's, digit for digit.
     columns, members = rows_of(out / "prediction_members.csv")
     assert columns == list(validate.PREDICTION_MEMBER_COLUMNS) and len(members) == 12 * len(ensemble_values())
-    for fresh, packaged in (("prediction.csv", "t3_prediction.csv"),
-                            ("prediction_members.csv", "t3_prediction_members.csv")):
-        assert (out / fresh).read_text() == (ROOT / "twin" / "experiments" / "data" / packaged).read_text(), (
+    for fresh, packaged in zip(score.VALIDATE_FILES, score.COMMITTED_FILES, strict=True):
+        assert (out / fresh).read_text() == (score.COMMITTED / packaged).read_text(), (
             f"twin/experiments/data/{packaged} is stale: copy a fresh twin validate's {fresh} there")
 
 

@@ -43,6 +43,7 @@ import numpy as np
 from twin.batch.tables import write_csv
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome, drawn
+from twin.experiments.calibrate import THESIS_RUNS
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
 from twin.experiments.validate import (
     PREDICTION_CELLS,
@@ -59,7 +60,8 @@ COMMITTED_FILES = ("t3_prediction.csv", "t3_prediction_members.csv")
 VALIDATE_FILES = ("prediction.csv", "prediction_members.csv")  # the same two, as `twin validate` names them
 RULES_WRITTEN = "2026-11-26"  # before any T3 measurement was seen
 MEASURED_COLUMNS = ("controller", "payload_g", "orientation", "rmse_mean_deg", "rmse_std_deg")
-OPTIONAL_COLUMNS = {"trajectory": 3, "runs": 5, "stalled_runs": None}  # and their values when left out
+MAX_RUNS = 1000  # runs per measured cell: more is a typing error, not a rig's day (left out: the thesis's five)
+SMALLEST_MEAN_DEG = 0.01  # a measured RMSE mean below this is no measurement (the Hall sensor's noise is 0.24 deg)
 TIE = "tie"  # the two means equal: neither tracked better (and the order is a toss)
 ORDER_LABELS = {**CONTROLLER_LABELS, TIE: "neither (equal means)"}
 TOSS_SE = 2.0  # measured means closer than this many combined standard errors: the order is a toss
@@ -69,10 +71,6 @@ ORDER_COLUMNS = ("payload_g", "orientation", "measured_better", "measured_toss",
 CONTROLLER_NAMES = {**{name: name for name in CONTROLLER_LABELS}, **{label.lower(): name for name, label in
                                                                       CONTROLLER_LABELS.items()}}
 CELL_KEYS = tuple((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # (controller, payload g, orientation)
-
-
-MAX_RUNS = 1000  # runs per measured cell: more is a typing error, not a rig's day
-SMALLEST_MEAN_DEG = 0.01  # a measured RMSE mean below this is no measurement (the Hall sensor's noise is 0.24 deg)
 
 
 def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
@@ -102,15 +100,14 @@ def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
         raise InvalidScenario(f"cannot read {what} {str(path)!r}: {error}".splitlines()[0]) from None
 
 
-def _number(text: str, where: str, column: str, *, low: float = 0.0, above: bool = False) -> float:
-    """``text`` as a finite number of at least ``low`` (above it when ``above``), else a one-line error."""
+def _number(text: str, where: str, column: str, *, low: float = 0.0) -> float:
+    """``text`` as a finite number of at least ``low``, else a one-line error."""
     try:
         value = float(text) if "_" not in text else math.nan
     except ValueError:
         value = math.nan
-    if not math.isfinite(value) or value < low or (above and value <= low):
-        need = f"a number above {low:g}" if above else f"a number of at least {low:g}"
-        raise InvalidScenario(f"{where}: {column} must be {need}, got {text!r}")
+    if not math.isfinite(value) or value < low:
+        raise InvalidScenario(f"{where}: {column} must be a number of at least {low:g}, got {text!r}")
     return value
 
 
@@ -165,7 +162,7 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
                               f"(it needs {', '.join(MEASURED_COLUMNS)}){hint}")
     found: dict[tuple, dict] = {}
     for where, key, row in _each_cell(rows, path, found):
-        runs = _whole(row.get("runs") or str(OPTIONAL_COLUMNS["runs"]), where, "runs", 2, MAX_RUNS)
+        runs = _whole(row.get("runs") or str(THESIS_RUNS), where, "runs", 2, MAX_RUNS)
         stalled = row.get("stalled_runs") or None
         found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG),
                       "std": _number(row["rmse_std_deg"], where, "rmse_std_deg"), "runs": runs,
@@ -241,12 +238,13 @@ def score(measured: dict[tuple, dict], predicted: dict[tuple, dict]) -> dict:
         m, p = measured[key], predicted[key]
         se = m["std"] / math.sqrt(m["runs"])
         ratio = p["mean"] / m["mean"]
+        low, high = min(p["members"]), max(p["members"])
         cells.append({"controller": key[0], "payload_g": key[1], "orientation": key[2], "measured": m["mean"],
                       "measured_std": m["std"], "runs": m["runs"], "twin_mean": p["mean"], "band_p10": p["p10"],
-                      "band_p90": p["p90"], "member_low": min(p["members"]), "member_high": max(p["members"]),
+                      "band_p90": p["p90"], "member_low": low, "member_high": high,
                       "ratio": ratio, "within": bool(rmse_within(p["mean"], m["mean"])),
                       "in_band": p["p10"] <= m["mean"] <= p["p90"],
-                      "in_members": min(p["members"]) <= m["mean"] <= max(p["members"]),
+                      "in_members": low <= m["mean"] <= high,
                       "z": _in_standard_errors(p["mean"] - m["mean"], se)})
     orders = []
     for payload_g, orientation in dict.fromkeys((g, o) for _, g, o in CELL_KEYS):
