@@ -144,6 +144,22 @@ def test_trial_t1_start_prints_what_as_built_md_quotes(capsys):
     }
 
 
+@pytest.mark.slow  # about 40 s: §8's eleven cells, ten seeds, eight ways (the plain runs and seven delays)
+def test_trial_actuation_delay_prints_what_as_built_md_quotes(capsys):
+    _load("trial_actuation_delay").main()
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "delay 0 gives the plain runs bit for bit: True"
+    rows = {line.split(":", 1)[0]: line.split(": ", 1)[1].split(" | ") for line in out[2:]}
+    # delay -> ["within 20 % N of 11", then per cell "law Tn RMSE (largest) xratio"]
+    assert [rows[f"delay {d} ms"][0] for d in (0, 1, 2, 3, 4, 6, 8)] == [
+        f"within 20 % {n} of 11" for n in (8, 8, 8, 5, 3, 0, 0)]
+    assert rows["delay 0 ms"][1:4] == ["pva T1 1.66 (7.7) x0.40", "pva T2 2.75 (6.0) x0.94", "pva T3 2.89 (7.3) x0.96"]
+    assert rows["delay 4 ms"][1:4] == ["pva T1 1.92 (8.5) x0.46", "pva T2 2.95 (7.4) x1.01", "pva T3 3.09 (8.6) x1.03"]
+    assert rows["delay 3 ms"][5:7] == ["ffpva T2 2.61 (6.3) x1.26", "ffpva T3 2.59 (7.7) x1.24"]
+    assert rows["delay 6 ms"][1:4] == ["pva T1 7.58 (15.5) x1.81", "pva T2 5.53 (14.0) x1.89", "pva T3 5.26 (14.9) x1.75"]
+    assert rows["delay 8 ms"][1] == "pva T1 8.84 (18.1) x2.10"
+
+
 @pytest.mark.slow  # about 9 min on 2 cores: 21 cells x 40 seeds and T3's 12 cells x 5 seeds, 14 chamber variants
 def test_trial_chamber_buildup_prints_what_the_docs_quote(capsys):
     _load("trial_chamber_buildup").main()
