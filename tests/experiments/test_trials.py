@@ -160,6 +160,34 @@ def test_trial_actuation_delay_prints_what_as_built_md_quotes(capsys):
     assert rows["delay 8 ms"][1] == "pva T1 8.84 (18.1) x2.10"
 
 
+@pytest.mark.slow  # about 1 min: sliding mode three ways on nine cells and T3's six, ten seeds; FF + PVA and PVA
+def test_trial_smc_compensation_prints_what_the_docs_quote(capsys):
+    from controllers import smc
+
+    as_given = smc.SlidingMode.update
+    _load("trial_smc_compensation").main()
+    assert smc.SlidingMode.update is as_given  # the trial puts the thesis's law back
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].endswith("FF + PVA T1-T4 1.60 / 2.20 / 2.14 / 1.82, PVA + DZC T1-T3 1.66 / 2.75 / 2.89")
+    assert out[1].endswith("FF + PVA: 2.14 / 2.41 / 2.64 / 2.19 / 2.45 / 3.49")
+    rows = {line[:24].strip(): line[24:].strip() for line in out[2::2]}
+    t3 = dict(zip(rows, (line.strip() for line in out[3::2]), strict=True))
+    assert rows["as the thesis gives it"].startswith(
+        "within 20 % 6 of 9, ahead of FF + PVA on 1 of 4, order right on 1 of 4 | T1 0 g H 1.34 x1.12 | "
+        "T2 0 g H 2.25 x1.45 | T3 0 g H 2.25 x1.33")
+    assert rows["on the held part"] == (
+        "within 20 % 7 of 9, ahead of FF + PVA on 4 of 4, order right on 4 of 4 | T1 0 g H 1.21 x1.01 | "
+        "T2 0 g H 2.07 x1.34 | T3 0 g H 2.03 x1.20 | T4 0 g H 1.57 x0.86 | T1 6.5 g H 1.26 x0.96 | "
+        "T1 13.5 g H 1.44 x1.18 | T1 0 g V 1.35 x0.86 | T1 6.5 g V 1.37 x0.91 | T1 13.5 g V 3.35 x0.96")
+    assert rows["on the sum"].startswith("within 20 % 5 of 9, ahead of FF + PVA on 4 of 4, order right on 4 of 4 | "
+                                         "T1 0 g H 0.96 x0.81 | T2 0 g H 1.61 x1.04 | T3 0 g H 1.56 x0.92")
+    assert t3 == {
+        "as the thesis gives it": "T3 sliding mode 2.25 / 2.58 / 2.72 / 2.26 / 2.59 / 3.49, ahead of FF + PVA on 1 of 6",
+        "on the held part": "T3 sliding mode 2.03 / 2.20 / 2.45 / 2.06 / 2.22 / 3.09, ahead of FF + PVA on 6 of 6",
+        "on the sum": "T3 sliding mode 1.56 / 1.71 / 1.92 / 1.57 / 1.80 / 2.77, ahead of FF + PVA on 6 of 6",
+    }
+
+
 @pytest.mark.slow  # about 9 min on 2 cores: 21 cells x 40 seeds and T3's 12 cells x 5 seeds, 14 chamber variants
 def test_trial_chamber_buildup_prints_what_the_docs_quote(capsys):
     _load("trial_chamber_buildup").main()
