@@ -30,19 +30,20 @@ import math
 import numpy as np
 
 from controllers import smc
-from controllers.ffpva import ffpva_duty
+from controllers.ffpva import FeedForwardPVAGains, ffpva_duty
+from controllers.pva import PVAGains
 from twin.envs.runner import run_many
-from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
+from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_PAYLOADS_G, THESIS_ROBUSTNESS_T1_DEG
 from twin.experiments.validate import rmse_within
 from twin.physics.model import Orientation
 from twin.sim.scenario import Scenario
 
 SEEDS = range(10)
-BAND = (20.0, 30.0)  # %, eq. 5.3.6, FF + PVA's compensation
+BAND = FeedForwardPVAGains(pva=PVAGains()).compensation_band  # %, eq. 5.3.6, FF + PVA's compensation
 # (trajectory, payload g, orientation, measured mean RMSE deg): §8's and §9's sliding mode cells
-SMC_CELLS = ((1, 0.0, "horizontal", 1.19), (2, 0.0, "horizontal", 1.55), (3, 0.0, "horizontal", 1.69),
-             (4, 0.0, "horizontal", 1.82), (1, 6.5, "horizontal", 1.31), (1, 13.5, "horizontal", 1.22),
-             (1, 0.0, "vertical", 1.57), (1, 6.5, "vertical", 1.51), (1, 13.5, "vertical", 3.48))
+SMC_CELLS = (*((t, 0.0, "horizontal", THESIS_EXPERIMENT_RMSE_DEG["smc"][t][0]) for t in (1, 2, 3, 4)),
+             *((1, g, o, THESIS_ROBUSTNESS_T1_DEG["smc", o][g][0]) for o in ("horizontal", "vertical")
+               for g in THESIS_PAYLOADS_G if (g, o) != (0.0, "horizontal")))
 T3_CELLS = tuple((g, o) for o in ("horizontal", "vertical") for g in (0.0, 6.5, 13.5))  # Chapter 6, held back
 
 

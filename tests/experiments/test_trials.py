@@ -144,20 +144,26 @@ def test_trial_t1_start_prints_what_as_built_md_quotes(capsys):
     }
 
 
-@pytest.mark.slow  # about 40 s: §8's eleven cells, ten seeds, eight ways (the plain runs and seven delays)
+@pytest.mark.slow  # about 1 min: §8's eleven cells, ten seeds, nine ways (the plain runs and eight delays)
 def test_trial_actuation_delay_prints_what_as_built_md_quotes(capsys):
+    from twin.physics.valves import ValveBank
+
+    plain = ValveBank.update
     _load("trial_actuation_delay").main()
+    assert ValveBank.update is plain  # the trial puts the valves back
     out = capsys.readouterr().out.splitlines()
     assert out[0] == "delay 0 gives the plain runs bit for bit: True"
     rows = {line.split(":", 1)[0]: line.split(": ", 1)[1].split(" | ") for line in out[2:]}
-    # delay -> ["within 20 % N of 11", then per cell "law Tn RMSE (largest) xratio"]
-    assert [rows[f"delay {d} ms"][0] for d in (0, 1, 2, 3, 4, 6, 8)] == [
-        f"within 20 % {n} of 11" for n in (8, 8, 8, 5, 3, 0, 0)]
+    # delay -> ["within 20 % N of 11", per cell "law Tn RMSE (largest) xratio", "pva T1 move .. hold .. SSE .."]
+    assert [rows[f"delay {d} ms"][0] for d in (0, 1, 2, 3, 4, 5, 6, 8)] == [
+        f"within 20 % {n} of 11" for n in (8, 7, 7, 7, 7, 5, 4, 1)]
     assert rows["delay 0 ms"][1:4] == ["pva T1 1.66 (7.7) x0.40", "pva T2 2.75 (6.0) x0.94", "pva T3 2.89 (7.3) x0.96"]
-    assert rows["delay 4 ms"][1:4] == ["pva T1 1.92 (8.5) x0.46", "pva T2 2.95 (7.4) x1.01", "pva T3 3.09 (8.6) x1.03"]
-    assert rows["delay 3 ms"][5:7] == ["ffpva T2 2.61 (6.3) x1.26", "ffpva T3 2.59 (7.7) x1.24"]
-    assert rows["delay 6 ms"][1:4] == ["pva T1 7.58 (15.5) x1.81", "pva T2 5.53 (14.0) x1.89", "pva T3 5.26 (14.9) x1.75"]
-    assert rows["delay 8 ms"][1] == "pva T1 8.84 (18.1) x2.10"
+    assert rows["delay 0 ms"][-1] == "pva T1 move 2.82 hold 0.42 SSE ±0.21 / ±0.71"
+    assert rows["delay 4 ms"][1:4] == ["pva T1 2.55 (10.2) x0.61", "pva T2 3.49 (10.1) x1.19", "pva T3 3.38 (10.2) x1.13"]
+    assert rows["delay 5 ms"][1:4] == ["pva T1 4.54 (12.8) x1.08", "pva T2 4.23 (14.1) x1.44", "pva T3 3.92 (13.1) x1.31"]
+    assert rows["delay 5 ms"][-1] == "pva T1 move 4.32 hold 4.65 SSE ±5.93 / ±6.09"
+    assert rows["delay 1 ms"][8] == "smc T1 1.53 (5.8) x1.29"
+    assert rows["delay 6 ms"][5:7] == ["ffpva T2 2.56 (6.1) x1.23", "ffpva T3 2.54 (7.1) x1.21"]
 
 
 @pytest.mark.slow  # about 1 min: sliding mode three ways on nine cells and T3's six, ten seeds; FF + PVA and PVA
