@@ -49,13 +49,20 @@ def row(law: str) -> str:
     runs = run_many([Scenario(law, 1, plant="as-built", seed=s) for s in SEEDS])
     rmse = np.array([math.degrees(r.metrics.rmse) for r in runs])
     largest = float(np.mean([math.degrees(r.metrics.max_error) for r in runs]))
+    move, hold, _, ranges = t1_move_hold_sse(runs)
+    return (f"{rmse.mean():.2f} ± {rmse.std(ddof=1):.2f}, largest {largest:.1f}, move {move:.2f} hold {hold:.2f}, "
+            f"SSE {ranges}")
+
+
+def t1_move_hold_sse(runs: list) -> tuple[float, float, np.ndarray, str]:
+    """T1 runs' RMS error over the move (0-1 s) and over the hold (from 1 s) (deg), each run's SSE (deg), and
+    the SSE ranges of each five runs as text ("±a / ±b")."""
     t = runs[0].trace.time
     error = np.array([np.degrees(r.trace.desired_angle - r.scored_angle) for r in runs])
     move, hold = (float(np.sqrt(np.mean(np.square(error[:, w])))) for w in (t < 1.0, t >= 1.0))
     sse = np.array([math.degrees(r.metrics.sse) for r in runs])
     ranges = " / ".join(f"±{np.nanmax(np.abs(sse[i:i + 5])):.2f}" for i in range(0, len(sse), 5))
-    return (f"{rmse.mean():.2f} ± {rmse.std(ddof=1):.2f}, largest {largest:.1f}, move {move:.2f} hold {hold:.2f}, "
-            f"SSE {ranges}")
+    return move, hold, sse, ranges
 
 
 def main() -> None:
