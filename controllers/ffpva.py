@@ -26,6 +26,13 @@ class FeedForwardPVAGains:
     compensation_band: tuple[float, float] = (20.0, 30.0)  # %, eq. 5.3.6
 
 
+def compensate(u: np.ndarray, band: tuple[float, float]) -> np.ndarray:
+    """Dead-zone compensation (eq. 5.3.6): a command whose magnitude lies in ``band`` = (low, high) %, ends
+    included, lifted to ``high`` with its sign; others unchanged."""
+    low, high = band
+    return np.where((np.abs(u) >= low) & (np.abs(u) <= high), high * np.sign(u), u)
+
+
 def ffpva_duty(nominal: NominalModel, gains: PVAGains, measurement: Measurement,
                setpoint: Setpoint) -> np.ndarray:
     """u_FF + u_PVA in %, before compensation and clipping."""
@@ -53,8 +60,5 @@ class FeedForwardPVA:
 
     def update(self, t: float, measurement: Measurement, setpoint: Setpoint) -> np.ndarray:
         del t
-        u = ffpva_duty(self.nominal, self.gains.pva, measurement, setpoint)
-        low, high = self.gains.compensation_band
-        lift = (np.abs(u) >= low) & (np.abs(u) <= high)
-        u = np.where(lift, high * np.sign(u), u)
+        u = compensate(ffpva_duty(self.nominal, self.gains.pva, measurement, setpoint), self.gains.compensation_band)
         return np.clip(u, -100.0, 100.0)

@@ -30,11 +30,11 @@ import math
 import numpy as np
 
 from controllers import smc
-from controllers.ffpva import FeedForwardPVAGains, ffpva_duty
+from controllers.ffpva import FeedForwardPVAGains, compensate, ffpva_duty
 from controllers.pva import PVAGains
 from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_PAYLOADS_G, THESIS_ROBUSTNESS_T1_DEG
-from twin.experiments.validate import rmse_within
+from twin.experiments.validate import PREDICTION_CELLS, _order, rmse_within
 from twin.physics.model import Orientation
 from twin.sim.scenario import Scenario
 
@@ -44,19 +44,13 @@ BAND = FeedForwardPVAGains(pva=PVAGains()).compensation_band  # %, eq. 5.3.6, FF
 SMC_CELLS = (*((t, 0.0, "horizontal", THESIS_EXPERIMENT_RMSE_DEG["smc"][t][0]) for t in (1, 2, 3, 4)),
              *((1, g, o, THESIS_ROBUSTNESS_T1_DEG["smc", o][g][0]) for o in ("horizontal", "vertical")
                for g in THESIS_PAYLOADS_G if (g, o) != (0.0, "horizontal")))
-T3_CELLS = tuple((g, o) for o in ("horizontal", "vertical") for g in (0.0, 6.5, 13.5))  # Chapter 6, held back
-
-
-def compensated(u: np.ndarray) -> np.ndarray:
-    """eq. 5.3.6: a command of 20-30 % either way lifted to 30 %."""
-    low, high = BAND
-    return np.where((np.abs(u) >= low) & (np.abs(u) <= high), high * np.sign(u), u)
+T3_CELLS = tuple((g, o) for c, _, g, o in PREDICTION_CELLS if c == "smc")  # Chapter 6, held back
 
 
 def on_the_held_part(self, t, measurement, setpoint):
     del t
     if self._calls % self._slow_every == 0:
-        self._held = compensated(ffpva_duty(self.nominal, self.gains.pva, measurement, setpoint))
+        self._held = compensate(ffpva_duty(self.nominal, self.gains.pva, measurement, setpoint), BAND)
     self._calls += 1
     return np.clip(self._held + self.switching(measurement, setpoint), -100.0, 100.0)
 
@@ -66,22 +60,26 @@ def on_the_sum(self, t, measurement, setpoint):
     if self._calls % self._slow_every == 0:
         self._held = ffpva_duty(self.nominal, self.gains.pva, measurement, setpoint)
     self._calls += 1
-    return np.clip(compensated(self._held + self.switching(measurement, setpoint)), -100.0, 100.0)
+    return np.clip(compensate(self._held + self.switching(measurement, setpoint), BAND), -100.0, 100.0)
 
 
-def mean_rmse(controller: str, trajectory: int, grams: float = 0.0, orientation: str = "horizontal") -> float:
-    runs = run_many([Scenario(controller, trajectory, payload=grams * 1e-3, orientation=Orientation(orientation),
-                              plant="as-built", seed=s) for s in SEEDS])
-    return float(np.mean([math.degrees(r.metrics.rmse) for r in runs]))
+def mean_rmse(cells: list[tuple[str, int, float, str]]) -> list[float]:
+    """Each (controller, trajectory, payload g, orientation) cell's mean RMSE over :data:`SEEDS` (deg), all
+    in one batch."""
+    runs = run_many([Scenario(c, t, payload=g * 1e-3, orientation=Orientation(o), plant="as-built", seed=s)
+                     for c, t, g, o in cells for s in SEEDS])
+    rmse = [math.degrees(r.metrics.rmse) for r in runs]
+    return [float(np.mean(rmse[i:i + len(SEEDS)])) for i in range(0, len(rmse), len(SEEDS))]
 
 
 def main() -> None:
-    ffpva = {t: mean_rmse("ffpva", t) for t in (1, 2, 3, 4)}
-    pva = {t: mean_rmse("pva", t) for t in (1, 2, 3)}
-    ffpva_t3 = [mean_rmse("ffpva", 3, g, o) for g, o in T3_CELLS]
+    flat = [(law, t, 0.0, "horizontal") for law in ("ffpva", "pva") for t in THESIS_EXPERIMENT_RMSE_DEG[law]]
+    base = mean_rmse(flat + [("ffpva", 3, g, o) for g, o in T3_CELLS])
+    others, ffpva_t3 = dict(zip(flat, base[:len(flat)], strict=True)), base[len(flat):]
+    ffpva = {t: others["ffpva", t, 0.0, "horizontal"] for t in (1, 2, 3, 4)}
     print("as-built, seeds 0-9, mean RMSE (deg) and x measured; FF + PVA T1-T4 "
           + " / ".join(f"{ffpva[t]:.2f}" for t in (1, 2, 3, 4)) + ", PVA + DZC T1-T3 "
-          + " / ".join(f"{pva[t]:.2f}" for t in (1, 2, 3)))
+          + " / ".join(f"{others['pva', t, 0.0, 'horizontal']:.2f}" for t in (1, 2, 3)))
     print("Chapter 6 T3 (0 / 6.5 / 13.5 g horizontal, then vertical), FF + PVA: "
           + " / ".join(f"{m:.2f}" for m in ffpva_t3))
     as_given = smc.SlidingMode.update
@@ -89,15 +87,16 @@ def main() -> None:
         for label, update in (("as the thesis gives it", as_given), ("on the held part", on_the_held_part),
                               ("on the sum", on_the_sum)):
             smc.SlidingMode.update = update
-            means = [mean_rmse("smc", t, g, o) for t, g, o, _ in SMC_CELLS]
+            everything = mean_rmse([("smc", t, g, o) for t, g, o, _ in SMC_CELLS]
+                                   + [("smc", 3, g, o) for g, o in T3_CELLS])
+            means, t3 = everything[:len(SMC_CELLS)], everything[len(SMC_CELLS):]
             within = sum(bool(rmse_within(m, c[3])) for m, c in zip(means, SMC_CELLS, strict=True))
             ahead = sum(m < ffpva[t] for m, (t, _, _, _) in zip(means[:4], SMC_CELLS[:4], strict=True))
-            right = sum(_order_right(t, means[t - 1], ffpva, pva) for t in (1, 2, 3, 4))
+            right = _orders_right({**others, **{("smc", t, 0.0, "horizontal"): means[t - 1] for t in (1, 2, 3, 4)}})
             cells = " | ".join(f"T{t} {g:g} g {o[0].upper()} {m:.2f} x{m / c:.2f}"
                                for m, (t, g, o, c) in zip(means, SMC_CELLS, strict=True))
             print(f"{label:24s} within 20 % {within} of 9, ahead of FF + PVA on {ahead} of 4, order right on "
                   f"{right} of 4 | {cells}", flush=True)
-            t3 = [mean_rmse("smc", 3, g, o) for g, o in T3_CELLS]
             print(f"{'':24s} T3 sliding mode " + " / ".join(f"{m:.2f}" for m in t3)
                   + f", ahead of FF + PVA on {sum(m < f for m, f in zip(t3, ffpva_t3, strict=True))} of 6",
                   flush=True)
@@ -105,12 +104,14 @@ def main() -> None:
         smc.SlidingMode.update = as_given  # the thesis's law back, for whatever runs after
 
 
-def _order_right(trajectory: int, smc_mean: float, ffpva: dict, pva: dict) -> bool:
-    """Whether the twin ranks the laws on ``trajectory`` as §8's measured means do."""
-    measured = {law: THESIS_EXPERIMENT_RMSE_DEG[law][trajectory][0] for law in ("pva", "ffpva", "smc")
-                if trajectory in THESIS_EXPERIMENT_RMSE_DEG[law]}
-    twin = {"smc": smc_mean, "ffpva": ffpva[trajectory], **({"pva": pva[trajectory]} if trajectory in pva else {})}
-    return sorted(measured, key=measured.get) == sorted(twin, key=twin.get)
+def _orders_right(twin: dict) -> int:
+    """On how many of §8's trajectories ``twin`` ((law, trajectory, 0.0, "horizontal") -> mean RMSE) ranks
+    the laws as the measured means do (`twin validate`'s ranking)."""
+    rows = [{"controller": law, "trajectory": t, "measured": THESIS_EXPERIMENT_RMSE_DEG[law][t][0],
+             "twin_mean": twin[law, t, 0.0, "horizontal"]} for law in THESIS_EXPERIMENT_RMSE_DEG
+            for t in THESIS_EXPERIMENT_RMSE_DEG[law]]
+    measured, ranked = _order(rows, "measured"), _order(rows, "twin_mean")
+    return sum(measured[t] == ranked[t] for t in measured)
 
 
 if __name__ == "__main__":

@@ -281,7 +281,7 @@ def test_trial_actuation_delay_prints_what_as_built_md_quotes(capsys):
     }
 
 
-@pytest.mark.slow  # about 1 min: sliding mode three ways on nine cells and T3's six, ten seeds; FF + PVA and PVA
+@pytest.mark.slow  # about 30 s: sliding mode three ways on nine cells and T3's six, ten seeds; FF + PVA and PVA
 def test_trial_smc_compensation_prints_what_the_docs_quote(capsys):
     from controllers import smc
 
