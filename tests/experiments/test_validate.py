@@ -166,6 +166,30 @@ def test_report_says_plainly_what_misses_and_what_the_runs_show():
     assert "some members' runs stall" in other
 
 
+def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_says():
+    """The opening lines count the same rows as the tables: 3 of the fake's 7 measured means within, its one
+    vertical payload cell out, each RMSE miss with its size and reading, the order wrong on T2 of T1-T2, the
+    open-loop lag out; which law tracks best on each payload and side of the prediction, and its stalls."""
+    v = _fake(0.6, lag_within=False, stalled=0, per_member=[[2.0, 2.2, 2.4, 2.6, 3.5, 3.4], [2.1, 2.3, 2.5, 2.7, 3.6, 3.3]])
+    v.prediction = [dict(v.prediction[0], controller=c, payload_g=g, twin_mean=x, stalled_runs=n)
+                    for c, g, x, n in (("ffpva", 0.0, 2.0, 0), ("smc", 0.0, 2.2, 0), ("ffpva", 6.5, 2.4, 0),
+                                       ("smc", 6.5, 2.6, 0), ("ffpva", 13.5, 3.5, 1),
+                                       ("smc", 13.5, 3.4, 2))]
+    text = validate.report(v)
+    short = text[text.index("## In short"):text.index("## Summary")]
+    assert ("- **Within the bar**: 3 of 7 measured RMSE means (Chapter 5 experiments 3 of 6, Chapter 6 T1 0 of 1); "
+            "of the vertical cells with a payload, 0 of 1, and no run of the measured cells stalls.") in short
+    assert "RMSE means: PVA + DZC T1 x0.40 (" in short and "sliding mode T1 13.5 g vertical x0.60 (" in short
+    assert "FF + PVA T1" not in short  # within
+    assert "The controller order, wrong on 1 of 2 Chapter 5 trajectories (T2: follows from the cells that miss)" in short
+    assert "The open-loop lag at reversals, out on 1 of 1." in short and "steady-error" not in short
+    assert ("- **Blind T3 prediction** (6 cells): FF + PVA tracks best on 2 of 3 payload and side cells, sliding "
+            "mode tracks best on 1 of 3 payload and side cells (the committed preset); 3 runs of the ensemble's "
+            "members stall.") in short
+    within = validate.report(_fake(1.0, lag_within=True, stalled=0))
+    assert "of the vertical cells with a payload, 1 of 1" in within and "open-loop" not in within.split("## Summary")[0]
+
+
 def test_report_judges_the_dependence_on_every_member_not_the_band_alone():
     """One member of eight set apart by its load friction lies mostly outside the interpolated 10-90 %
     band (2.8-3.1 here); the report still says the cell turns on it, names that member and lists the

@@ -51,5 +51,5 @@ def add_parser(sub) -> None:
     cal.add_argument("--workers", type=arguments.workers, default=max(1, min(os.cpu_count() or 1, 4)),
                      help="processes (default: the cores, at most 4)")
     cal.add_argument("--install", action="store_true",
-                     help="also make the result the as-built preset (twin/data/as_built.json)")
+                     help="also make the result the as-built preset (twin/plants/data/as_built.json)")
     cal.set_defaults(func=_cmd_calibrate)

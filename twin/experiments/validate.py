@@ -1402,6 +1402,71 @@ def _why(v: Validation) -> list[str]:
     return lines
 
 
+def _in_short(v: Validation) -> list[str]:
+    """The report's opening: what is within the bar, what is not (each miss's size and reading), and what the
+    blind prediction says, in three lines computed from the same rows as the tables below. Added 2026-11-27,
+    after every result it reads: it says again what the tables say, in short."""
+    measured = [r for r in v.rows if r["source"] in ("chapter 5 experiment", "chapter 6 T1")]
+    within = [r for r in measured if r["within_tolerance"]]
+    parts = ", ".join(f"{label} {sum(r['within_tolerance'] for r in rs)} of {len(rs)}"
+                      for source, label in (("chapter 5 experiment", "Chapter 5 experiments"),
+                                            ("chapter 6 T1", "Chapter 6 T1"))
+                      if (rs := [r for r in measured if r["source"] == source]))
+    heavy = [r for r in measured if r["payload_g"] and r["orientation"] == "vertical"]
+    stalled = sum(v.stalled.values())
+    first = f"- **Within the bar**: {len(within)} of {len(measured)} measured RMSE means ({parts})"
+    if heavy:
+        first += (f"; of the vertical cells with a payload, {sum(r['within_tolerance'] for r in heavy)} of "
+                  f"{len(heavy)}")
+    first += (", and no run of the measured cells stalls." if not stalled else
+              f"; {stalled} runs of the measured cells stall.")
+    checked = [r for r in v.rows if r["source"].startswith("4.4.3 valve test") and "below" not in r["source"]]
+    delays = [r for r in v.rows if r["source"].startswith("4.4.3 valve") and "delay" in r["source"]]
+    if checked or delays:
+        first += (f" The valve: R(d) within 15 % of eq. 4.4.2 at {sum(r['within_tolerance'] for r in checked)} of "
+                  f"{len(checked)} duties from 35 %, delays within 1 ms on {sum(r['within_tolerance'] for r in delays)}"
+                  f" of {len(delays)}.")
+    missed = misses(v)
+    rmse = [m for m in missed if m["comparison"] == "RMSE" and m["missed_on"] == "seeds 0-4"]
+    orders = [m for m in missed if m["comparison"] == "controller order" and m["missed_on"] == "seeds 0-4"]
+    sse = [r for r in v.rows if r["source"].endswith("T1 SSE range")]
+    out = []
+    if rmse:
+        out.append("RMSE means: " + "; ".join(f"{_cell_name(m)} x{m['off_by']:.2f} ({READINGS[m['reading']]})"
+                                              for m in rmse))
+    if orders:
+        trajectories = {r["trajectory"] for r in v.rows if r["source"] == "chapter 5 experiment"}
+        out.append(f"the controller order, wrong on {len(orders)} of {len(trajectories)} Chapter 5 trajectories ("
+                   + "; ".join(f"T{m['trajectory']}: {READINGS[m['reading']]}" for m in orders) + ")")
+    if sse and not all(r["within_tolerance"] for r in sse):
+        out.append(f"T1 steady-error ranges, out on {sum(not r['within_tolerance'] for r in sse)} of {len(sse)}")
+    for source, what in (("chapter 5 simulation", "the `thesis` plant's Chapter 5 simulations"),
+                         ("4.6", "the open-loop lag at reversals")):
+        rs = [r for r in v.rows if r["source"].startswith(source)]
+        if rs and not all(r["within_tolerance"] for r in rs):
+            out.append(f"{what}, out on {sum(not r['within_tolerance'] for r in rs)} of {len(rs)}")
+    lines = [first]
+    if out:
+        lines.append("- **Out of it** (seeds 0-4; a reading links a miss to another check, it does not prove its "
+                     "cause; the sections below say more): " + ". ".join(x[0].upper() + x[1:] for x in out) + ".")
+    if v.prediction:
+        pairs: dict[tuple, dict] = {}
+        for r in v.prediction:
+            pairs.setdefault((r["payload_g"], r["orientation"]), {})[r["controller"]] = r["twin_mean"]
+        both = [p for p in pairs.values() if len(p) > 1]
+        leads: dict[str, int] = {}
+        for p in both:
+            best = min(p, key=p.get)
+            leads[best] = leads.get(best, 0) + 1
+        stalls = sum(r["stalled_runs"] for r in v.prediction)
+        lines.append(f"- **Blind T3 prediction** ({len(v.prediction)} cell{'s' if len(v.prediction) > 1 else ''}): "
+                     + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {len(both)} payload and side cells"
+                                  for c, n in sorted(leads.items())) + " (the committed preset); " if both else "")
+                     + ("no run of any ensemble member stalls." if not stalls else
+                        f"{stalls} runs of the ensemble's members stall."))
+    return lines
+
+
 def report(v: Validation) -> str:
     """``validation.md``: what matches, what does not, and why as far as the twin shows."""
     rows = v.rows
@@ -1417,6 +1482,7 @@ def report(v: Validation) -> str:
              "`within` is each comparison's tolerance: ±0.35 deg for the thesis's simulations, 20 % for measured "
              "RMSE means, ±0.5 deg for T1 steady-error ranges, 15 % for the valve's R(d) from 35 % duty, 1 ms "
              "for the valve's delays.", "",
+             "## In short", "", *_in_short(v), "",
              "## Summary", "", "| comparison | plant | within tolerance |", "|---|---|---|"]
     for head, members in groups.items():
         lines.append(f"| {head} | {members[0]['plant']} | {sum(r['within_tolerance'] for r in members)} of "
