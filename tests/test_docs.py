@@ -43,3 +43,24 @@ def test_the_digest_follows_every_value_of_the_calibration_and_nothing_else(tmp_
             path = tmp_path / f"{where}-{name}.json"
             path.write_text(json.dumps(moved), encoding="utf-8")
             assert as_built.preset_digest(path) != committed, (where, name)
+
+
+def test_every_import_in_the_docs_python_blocks_resolves():
+    """A page's example starts with its imports; each one, run alone, imports (``from twin import env`` in
+    docs/environment.md did not, after the package was split into layers)."""
+    import importlib
+    import importlib.util
+
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    imports = [(page.name, line.strip()) for page in pages
+               for block in re.findall(r"```python\n(.*?)```", page.read_text(encoding="utf-8"), re.S)
+               for line in block.splitlines() if re.match(r"\s*(from \S+ )?import ", line)]
+    assert len(imports) >= 7  # the README's, commands.md's and environment.md's
+    for page, line in imports:
+        match = re.match(r"from (\S+) import (.+)", line)
+        if match is None:
+            importlib.import_module(line.split()[1])
+            continue
+        module = importlib.import_module(match[1])
+        for name in (n.split(" as ")[0].strip() for n in match[2].split(",")):
+            assert hasattr(module, name) or importlib.util.find_spec(f"{match[1]}.{name}"), f"{page}: {line}"
