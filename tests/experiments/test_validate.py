@@ -610,7 +610,7 @@ def _miss_report() -> tuple[validate.Validation, list[dict], str]:
     return v, validate.misses(v), validate.report(v)
 
 
-def test_misses_read_each_miss_by_the_first_rule_that_applies():
+def test_misses_read_each_miss_by_the_first_rule_that_applies(monkeypatch):
     v, missed, text = _miss_report()
     read = {(m["comparison"], m["controller"], m["trajectory"], m["payload_g"], m["orientation"]): m for m in missed}
     assert [m["reading"] for m in missed] == ["largest error", "largest error", "draw", "opening lag", "base level",
@@ -703,6 +703,18 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies():
     last = validate.misses(v)[-1]
     assert (last["trajectory"], last["reading"]) == (2, "open")
     assert last["what_the_twin_shows"] == "every cell of T2 is within 20 %: the order turns on differences inside it"
+    # The same order, had the rig's sliding mode T2 runs scattered with a std of 0.9: 0.53 / sqrt((0.9^2 + 0.21^2) /
+    # 5) = 1.28 combined standard errors between the two means, under 2, so the rig's runs do not settle it.
+    smc_measured = validate.THESIS_EXPERIMENT_RMSE_DEG["smc"]
+    monkeypatch.setitem(validate.THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, 0.9)})
+    noise = validate.misses(v)[-1]
+    assert (noise["trajectory"], noise["reading"]) == (2, "rig noise")
+    assert noise["what_the_twin_shows"] == (
+        "the rig's five runs put sliding mode (1.55 ± 0.90) ahead of FF + PVA (2.08 ± 0.21) by 1.3 combined standard "
+        "errors, under 2: the measurements do not settle the order the twin gets the other way")
+    monkeypatch.setitem(validate.THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, 0.5)})  # 2.19 apart
+    assert validate.misses(v)[-1]["reading"] == "open"
+    monkeypatch.setitem(validate.THESIS_EXPERIMENT_RMSE_DEG, "smc", smc_measured)
     fresh_t2 = {r["controller"]: r for r in v.seeds if r["trajectory"] == 2}
     fresh_t2["smc"]["twin_mean"] = 1.9  # right on the fresh seeds (1.9 < 2.1 < 2.9): the draw
     assert validate.misses(v)[-1]["reading"] == "draw" and validate.misses(v)[-1]["what_the_twin_shows"] == (

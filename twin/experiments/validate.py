@@ -42,6 +42,7 @@ from twin.experiments.base import Experiment, Outcome, drawn
 from twin.experiments.reference import (
     ROBUSTNESS_CELLS,
     THESIS_EXPERIMENT_MAX_ERROR_DEG,
+    THESIS_EXPERIMENT_RMSE_DEG,
     THESIS_FULL_DUTY_SPEEDS,
     THESIS_SIMULATED_RMSE_DEG,
 )
@@ -1047,6 +1048,7 @@ READINGS = {
     "scatter": "where the runs end scatters",  # an SSE range out on the fresh seeds too, their ends centred near 0
     "offset": "where the runs end is off zero",  # the same, their ends centred away from 0
     "follows": "follows from the cells that miss",  # an order that the measured values of its out cells restore
+    "rig noise": "the rig's runs do not settle it",  # every pair the twin swaps is under 2 s.e. apart on the rig
     "failed": "runs that failed",  # a mean that is not a number: some run failed
     "open": "not shown by the twin",
 }
@@ -1215,6 +1217,13 @@ def misses(v: Validation) -> list[dict]:
             reading = "follows"
             text = (", ".join(f"{_cell_name(r)} is out (x{r['ratio']:.2f})" for r in out_cells)
                     + "; with the measured values in their place the order is right")
+        elif (unsettled := _unsettled_pairs(on)) is not None:
+            reading = "rig noise"
+            text = ("; ".join(f"the rig's five runs put {CONTROLLER_LABELS[a]} ({_measured_text(a, t)}) ahead of "
+                              f"{CONTROLLER_LABELS[b]} ({_measured_text(b, t)}) by {z:.1f} combined standard errors"
+                              for a, b, z in unsettled)
+                    + f", under {EFFECT_SIGNIFICANCE:g}: the measurements do not settle the order the twin gets "
+                    "the other way")
         elif out_cells:
             reading, text = "open", ("with the measured values in place of the cells that are out the order is "
                                      "still wrong")
@@ -1229,6 +1238,26 @@ def misses(v: Validation) -> list[dict]:
         add("controller order", order_row, None, rig[t], twin[t], None,
             fresh_order[t] if complete else None, right, None, reading, text)
     return out
+
+
+def _measured_text(controller: str, trajectory: int) -> str:
+    mean, std = THESIS_EXPERIMENT_RMSE_DEG[controller][trajectory]
+    return f"{mean:.2f} ± {std:.2f}"
+
+
+def _unsettled_pairs(rows: Sequence[dict]) -> list[tuple[str, str, float]] | None:
+    """Each pair of controllers that the twin's means (``rows``, one trajectory's Chapter 5 cells) rank the
+    other way from the rig's, as (ahead on the rig, behind on the rig, their measured difference in combined
+    standard errors of the thesis's five-run means); ``None`` when the twin swaps no pair or any pair it swaps
+    is at least :data:`EFFECT_SIGNIFICANCE` apart. Added 2026-11-27, after the T4 order it reads."""
+    pairs = []
+    for a in rows:
+        for b in rows:
+            if a["measured"] < b["measured"] and a["twin_mean"] > b["twin_mean"]:
+                (ma, sa), (mb, sb) = (THESIS_EXPERIMENT_RMSE_DEG[r["controller"]][r["trajectory"]] for r in (a, b))
+                pairs.append((a["controller"], b["controller"],
+                              (mb - ma) / math.sqrt((sa**2 + sb**2) / calibrate.THESIS_RUNS)))
+    return pairs if pairs and all(z < EFFECT_SIGNIFICANCE for *_, z in pairs) else None
 
 
 def _miss_value(x, comparison: str) -> str:
@@ -1516,10 +1545,13 @@ def report(v: Validation) -> str:
                   f"more (or less) than the rig by more than {EFFECT_SIGNIFICANCE:g} standard errors, the way it "
                   "misses; **where the runs end scatters** (or **is off zero**) for an SSE range out on the fresh "
                   "seeds too, by whether the twin's signed steady errors centre within half a std of zero; "
-                  "**follows** for an order that the measured values of its out cells would put right; else "
+                  "**follows** for an order that the measured values of its out cells would put right; **the "
+                  "rig's runs do not settle it** for one whose every pair the twin ranks the other way is less than "
+                  f"{EFFECT_SIGNIFICANCE:g} combined standard errors apart in the thesis's five-run means; else "
                   "**not shown by the twin**. A reading links a miss to another check; it is not a proof of its "
                   "cause. The table and its rules were added on 2026-11-25, after every result they read; **its "
-                  "payload's cost** on 2026-11-26, after the one miss it reads.", "",
+                  "payload's cost** on 2026-11-26, after the one miss it reads; **the rig's runs do not settle it** on "
+                  "2026-11-27, after the one order it reads.", "",
                   "| comparison | missed on | cell | measured | twin, seeds 0-4 | off by | fresh seeds | reading | "
                   "what the other checks show |", "|---|---|---|---|---|---|---|---|---|"]
         lines += [_miss_row(m) for m in missed]
