@@ -55,10 +55,12 @@ def _range(text: str, kind: type, flag: str) -> list:
         raise InvalidScenario(f"bad range {text!r} for {flag}: step must be positive")
     if stop < start:
         raise InvalidScenario(f"bad range {text!r} for {flag}: stop before start")
-    count = int(math.floor((stop - start) / step + 1e-9)) + 1
-    if count > MAX_POINTS:
-        raise InvalidScenario(f"range {text!r} for {flag} has {count:,} values: more than the {MAX_POINTS:,} "
+    span = (stop - start) / step  # inf when a tiny step overflows it
+    if not span + 1 <= MAX_POINTS:
+        size = f"{int(span) + 1:,} values" if span < 1e12 else "over a trillion values"
+        raise InvalidScenario(f"range {text!r} for {flag} has {size}: more than the {MAX_POINTS:,} "
                               "scenarios a sweep takes")
+    count = int(math.floor(span + 1e-9)) + 1
     values = [round(start + i * step, 12) + 0.0 for i in range(count)]
     return [_whole(v) for v in values] if kind is int else values
 

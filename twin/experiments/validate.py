@@ -1048,7 +1048,8 @@ READINGS = {
     "scatter": "where the runs end scatters",  # an SSE range out on the fresh seeds too, their ends centred near 0
     "offset": "where the runs end is off zero",  # the same, their ends centred away from 0
     "follows": "follows from the cells that miss",  # an order that the measured values of its out cells restore
-    "rig noise": "the rig's runs do not settle it",  # every pair the twin swaps is under 2 s.e. apart on the rig
+    "rig noise": "the rig's runs do not settle it",  # each pair the twin swaps: under 2 s.e. apart on the rig, and
+    # the twin's gap under 2 s.e. from the rig's
     "failed": "runs that failed",  # a mean that is not a number: some run failed
     "open": "not shown by the twin",
 }
@@ -1209,6 +1210,7 @@ def misses(v: Validation) -> list[dict]:
             continue
         on = [r for r in (finite if rig[t] != twin[t] else fresh_flat) if r["trajectory"] == t]
         out_cells = [r for r in on if not r["within_tolerance"]]
+        pairs = _swapped_pairs(on)
         restored = _order([dict(r, twin_mean=r["measured"] if r in out_cells else r["twin_mean"]) for r in on],
                           "twin_mean").get(t)
         if rig[t] != twin[t] and right:
@@ -1217,19 +1219,18 @@ def misses(v: Validation) -> list[dict]:
             reading = "follows"
             text = (", ".join(f"{_cell_name(r)} is out (x{r['ratio']:.2f})" for r in out_cells)
                     + "; with the measured values in their place the order is right")
-        elif (unsettled := _unsettled_pairs(on)) is not None:
+        elif pairs and all(max(p["rig_z"], p["gap_z"]) < EFFECT_SIGNIFICANCE for p in pairs):
             reading = "rig noise"
-            text = ("; ".join(f"the rig's five runs put {CONTROLLER_LABELS[a]} ({_measured_text(a, t)}) ahead of "
-                              f"{CONTROLLER_LABELS[b]} ({_measured_text(b, t)}) by {z:.1f} combined standard errors"
-                              for a, b, z in unsettled)
-                    + f", under {EFFECT_SIGNIFICANCE:g}: the measurements do not settle the order the twin gets "
-                    "the other way")
+            text = (_pairs_text(pairs) + f", each under {EFFECT_SIGNIFICANCE:g}: the measurements do not settle the "
+                    "order, and the twin's is as far from theirs as their own noise")
         elif out_cells:
             reading, text = "open", ("with the measured values in place of the cells that are out the order is "
                                      "still wrong")
         else:
             reading = "open"
             text = f"every cell of T{t} is within {RMSE_TOLERANCE * 100:.0f} %: the order turns on differences inside it"
+        if reading == "open" and pairs:
+            text += "; " + _pairs_text(pairs)
         right_members = member_orders(v.prediction_detail, rig).get(t)
         if right_members is not None:
             text += "; seeds 0-4 put it " + _members_right_text(v.prediction_detail, t, right_members)
@@ -1245,19 +1246,32 @@ def _measured_text(controller: str, trajectory: int) -> str:
     return f"{mean:.2f} ± {std:.2f}"
 
 
-def _unsettled_pairs(rows: Sequence[dict]) -> list[tuple[str, str, float]] | None:
-    """Each pair of controllers that the twin's means (``rows``, one trajectory's Chapter 5 cells) rank the
-    other way from the rig's, as (ahead on the rig, behind on the rig, their measured difference in combined
-    standard errors of the thesis's five-run means); ``None`` when the twin swaps no pair or any pair it swaps
-    is at least :data:`EFFECT_SIGNIFICANCE` apart. Added 2026-11-27, after the T4 order it reads."""
+def _swapped_pairs(rows: Sequence[dict]) -> list[dict]:
+    """Each pair of controllers that the twin's means (``rows``, one trajectory's Chapter 5 cells, on seeds 0-4
+    or on the fresh seeds) rank the other way from the rig's: ``ahead`` and ``behind`` on the rig, ``rig_z`` the
+    rig's gap in combined standard errors of the thesis's five-run means, ``twin_gap`` the twin's (deg, the
+    other way) and ``gap_z`` how far the twin's gap lies from the rig's, in the two gaps' combined standard
+    errors (the twin's from its runs' std). Added 2026-11-27, after the T4 order it reads."""
     pairs = []
     for a in rows:
         for b in rows:
             if a["measured"] < b["measured"] and a["twin_mean"] > b["twin_mean"]:
                 (ma, sa), (mb, sb) = (THESIS_EXPERIMENT_RMSE_DEG[r["controller"]][r["trajectory"]] for r in (a, b))
-                pairs.append((a["controller"], b["controller"],
-                              (mb - ma) / math.sqrt((sa**2 + sb**2) / calibrate.THESIS_RUNS)))
-    return pairs if pairs and all(z < EFFECT_SIGNIFICANCE for *_, z in pairs) else None
+                rig_se = math.sqrt((sa**2 + sb**2) / calibrate.THESIS_RUNS)
+                twin_se = math.sqrt((a["twin_std"] ** 2 + b["twin_std"] ** 2) / a.get("runs", len(SEEDS)))
+                twin_gap = a["twin_mean"] - b["twin_mean"]
+                pairs.append({"ahead": a["controller"], "behind": b["controller"], "trajectory": a["trajectory"],
+                              "rig_z": (mb - ma) / rig_se, "twin_gap": twin_gap,
+                              "gap_z": (mb - ma + twin_gap) / math.hypot(rig_se, twin_se)})
+    return pairs
+
+
+def _pairs_text(pairs: Sequence[dict]) -> str:
+    return "; ".join(
+        f"the rig's five runs put {CONTROLLER_LABELS[p['ahead']]} ({_measured_text(p['ahead'], p['trajectory'])}) "
+        f"ahead of {CONTROLLER_LABELS[p['behind']]} ({_measured_text(p['behind'], p['trajectory'])}) by "
+        f"{p['rig_z']:.1f} combined standard errors, and the twin's gap the other way ({p['twin_gap']:.2f} deg) lies "
+        f"{p['gap_z']:.1f} of the two gaps' combined standard errors from the rig's" for p in pairs)
 
 
 def _miss_value(x, comparison: str) -> str:
@@ -1271,7 +1285,7 @@ def _miss_row(m: dict) -> str:
     """One :func:`misses` row as a line of the report's table."""
     kind = m["comparison"]
     cell = f"T{m['trajectory']}" if m["controller"] is None else _cell_name(m)
-    off = ("" if m["off_by"] is None else f"x{m['off_by']:.2f}" if kind == "RMSE" else f"{m['off_by']:+.3f} deg")
+    off = ("" if m["off_by"] is None else _times(m["off_by"]) if kind == "RMSE" else f"{m['off_by']:+.3f} deg")
     fresh = ""
     if m["fresh"] is not None:
         verdict = (("right" if m["fresh_within"] else "wrong") if kind == "controller order" else
@@ -1431,6 +1445,15 @@ def _why(v: Validation) -> list[str]:
     return lines
 
 
+def _runs(n: int) -> str:
+    return f"{n} run{'' if n == 1 else 's'}"
+
+
+def _times(ratio) -> str:
+    """A twin / measured ratio as the report writes it (x1.31), or "failed" for a mean that is not a number."""
+    return "failed" if ratio is None or not math.isfinite(ratio) else f"x{ratio:.2f}"
+
+
 def _in_short(v: Validation) -> list[str]:
     """The report's opening: what is within the bar, what is not (each miss's size and reading), and what the
     blind prediction says, in three lines computed from the same rows as the tables below. Added 2026-11-27,
@@ -1446,9 +1469,9 @@ def _in_short(v: Validation) -> list[str]:
     first = f"- **Within the bar**: {len(within)} of {len(measured)} measured RMSE means ({parts})"
     if heavy:
         first += (f"; of the vertical cells with a payload, {sum(r['within_tolerance'] for r in heavy)} of "
-                  f"{len(heavy)}")
+                  f"{len(heavy)} RMSE means")
     first += (", and no run of the measured cells stalls." if not stalled else
-              f"; {stalled} runs of the measured cells stall.")
+              f"; {_runs(stalled)} of the measured cells stall{'s' if stalled == 1 else ''}.")
     checked = [r for r in v.rows if r["source"].startswith("4.4.3 valve test") and "below" not in r["source"]]
     delays = [r for r in v.rows if r["source"].startswith("4.4.3 valve") and "delay" in r["source"]]
     if checked or delays:
@@ -1461,14 +1484,19 @@ def _in_short(v: Validation) -> list[str]:
     sse = [r for r in v.rows if r["source"].endswith("T1 SSE range")]
     out = []
     if rmse:
-        out.append("RMSE means: " + "; ".join(f"{_cell_name(m)} x{m['off_by']:.2f} ({READINGS[m['reading']]})"
+        out.append("RMSE means: " + "; ".join(f"{_cell_name(m)} {_times(m['off_by'])} ({READINGS[m['reading']]})"
                                               for m in rmse))
     if orders:
         trajectories = {r["trajectory"] for r in v.rows if r["source"] == "chapter 5 experiment"}
         out.append(f"the controller order, wrong on {len(orders)} of {len(trajectories)} Chapter 5 trajectories ("
                    + "; ".join(f"T{m['trajectory']}: {READINGS[m['reading']]}" for m in orders) + ")")
     if sse and not all(r["within_tolerance"] for r in sse):
-        out.append(f"T1 steady-error ranges, out on {sum(not r['within_tolerance'] for r in sse)} of {len(sse)}")
+        readings: dict[str, int] = {}
+        for m in missed:
+            if m["comparison"] == "T1 SSE range" and m["missed_on"] == "seeds 0-4":
+                readings[m["reading"]] = readings.get(m["reading"], 0) + 1
+        out.append(f"T1 steady-error ranges, out on {sum(not r['within_tolerance'] for r in sse)} of {len(sse)} ("
+                   + ", ".join(f"{READINGS[k]}: {n}" for k, n in readings.items()) + ")")
     for source, what in (("chapter 5 simulation", "the `thesis` plant's Chapter 5 simulations"),
                          ("4.6", "the open-loop lag at reversals")):
         rs = [r for r in v.rows if r["source"].startswith(source)]
@@ -1481,6 +1509,8 @@ def _in_short(v: Validation) -> list[str]:
     if v.prediction:
         pairs: dict[tuple, dict] = {}
         for r in v.prediction:
+            if r["twin_mean"] is None or not math.isfinite(r["twin_mean"]):
+                continue  # a failed run: no mean to rank
             pairs.setdefault((r["payload_g"], r["orientation"]), {})[r["controller"]] = r["twin_mean"]
         both = [p for p in pairs.values() if len(p) > 1]
         leads: dict[str, int] = {}
@@ -1492,7 +1522,7 @@ def _in_short(v: Validation) -> list[str]:
                      + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {len(both)} payload and side cells"
                                   for c, n in sorted(leads.items())) + " (the committed preset); " if both else "")
                      + ("no run of any ensemble member stalls." if not stalls else
-                        f"{stalls} runs of the ensemble's members stall."))
+                        f"{_runs(stalls)} of the ensemble's members stall{'s' if stalls == 1 else ''}."))
     return lines
 
 
@@ -1547,7 +1577,8 @@ def report(v: Validation) -> str:
                   "seeds too, by whether the twin's signed steady errors centre within half a std of zero; "
                   "**follows** for an order that the measured values of its out cells would put right; **the "
                   "rig's runs do not settle it** for one whose every pair the twin ranks the other way is less than "
-                  f"{EFFECT_SIGNIFICANCE:g} combined standard errors apart in the thesis's five-run means; else "
+                  f"{EFFECT_SIGNIFICANCE:g} combined standard errors apart in the thesis's five-run means, with the "
+                  "twin's gap less than as far from the rig's; else "
                   "**not shown by the twin**. A reading links a miss to another check; it is not a proof of its "
                   "cause. The table and its rules were added on 2026-11-25, after every result they read; **its "
                   "payload's cost** on 2026-11-26, after the one miss it reads; **the rig's runs do not settle it** on "
