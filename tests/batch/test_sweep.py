@@ -53,6 +53,16 @@ def test_bad_axis_values_are_rejected_naming_the_value(name, value):
         grid.expand({name: grid.parse_axis(name, value)})
 
 
+@pytest.mark.parametrize("value, size", [("0:1e300:1e-300", "over a trillion values"),  # the count overflows
+                                         ("0:1:1e-300", "over a trillion values"),
+                                         ("0:200000:1", "200,001 values"), ("0:100000:1", "100,001 values")])
+def test_a_range_over_the_cap_is_refused_with_its_size_before_any_value_is_made(value, size):
+    with pytest.raises(InvalidScenario, match=f"{re.escape(repr(value))} for --payload has {size}: more than the "
+                                              "100,000"):
+        grid.parse_axis("payload", value)
+    assert len(grid.parse_axis("payload", "1:100000:1")) == 100_000  # the cap itself is allowed
+
+
 @pytest.mark.parametrize("name, value", [("seed", "0,0"), ("payload", "0,0.0"), ("payload", "-0,0"),
                                          ("controller", "smc,smc")])
 def test_repeated_values_give_one_scenario(name, value):

@@ -440,6 +440,22 @@ def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, 
     (["whatif", "air", "--out", "OUT", "--air", "25"], "--air: each value must be 0-20 % of the chamber volume"),
     (["whatif", "air", "--out", "OUT", "--air", ",".join(str(k / 10) for k in range(60))], "--air: at most 50 values"),
     (["whatif", "pva-rate", "--out", "OUT", "--rates", "16"], "a period other than the thesis's 16 ms"),
+    # Found by probing again (2026-11-27): a range whose step is so small its count overflows was a traceback, and
+    # the what-ifs below had no cap (the first took 23 GB before it was killed); whatif payload's refusal came
+    # after its folder was made. Each count is the what-if's own: laws or controllers x cells x values x seeds.
+    (["sweep", "--payload", "0:1e300:1e-300", "--out", "OUT"], "has over a trillion values: more than the 100,000"),
+    (["whatif", "lift", "--out", "OUT", "--pressures", "1:700:0.01"], "--pressures would make 1,179,938 runs"),
+    (["whatif", "pwm", "--out", "OUT", "--periods", "4:100:1", "--seeds", "1000"],
+     "--periods x --seeds would make 388,000 runs: more than the 100,000 a what-if takes"),
+    (["whatif", "smc-phi", "--out", "OUT", "--phis", ",".join(f"{k / 100:g}" for k in range(1, 301)), "--seeds",
+      "1000"], "--phis x --seeds would make 2,718,000 runs"),  # (300 + 2) laws x 9 cells x 1000
+    (["whatif", "pva-rate", "--out", "OUT", "--rates", ",".join(str(k) for k in range(1, 65)), "--seeds", "1000"],
+     f"--rates x --seeds x --members would make {28 * 64 * 1000 * len(ensemble_values()):,} runs"),
+    (["whatif", "observer", "--out", "OUT", "--seeds", "1000"],
+     f"--seeds x --members would make {16 * 1000 * len(ensemble_values()):,} runs"),
+    (["whatif", "payload", "--out", "OUT", "--payloads", "0:200:0.01", "--seeds", "1000"],
+     "--payloads x --seeds would make 80,004,000 runs"),
+    (["bench", "--batch", "1000000"], "runs in the batch must be an integer from 1 to 10,000"),
     (["whatif", "gear-load", "--out", ""], "the output folder must be named"),
     (["sweep", "--controller", "ffpva", "--trajectory", "1", "--out", ""], "the output folder must be named"),
     (["view", "--controller", "smc", "--trajectory", "4", "--html", "/proc/a.html"], "cannot write '/proc/a.html'"),

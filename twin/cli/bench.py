@@ -7,6 +7,8 @@ import sys
 
 from twin.experiments import arguments
 
+MAX_BATCH = 10_000  # runs in bench's batch: 100 times the default, about an hour on one core
+
 
 def _cmd_bench(args: argparse.Namespace) -> int:
     from tqdm import tqdm
@@ -25,6 +27,8 @@ def _cmd_bench(args: argparse.Namespace) -> int:
 
 def add_parser(sub) -> None:
     bench = sub.add_parser("bench", help="cost per simulated second, as ratios to bare mj_step")
-    bench.add_argument("--batch", type=arguments.positive_int, default=100, help="runs in the batched case (default 100)")
+    bench.add_argument("--batch", type=arguments.checked(int, lambda v: 1 <= v <= MAX_BATCH,
+                                                         f"runs in the batch must be an integer from 1 to {MAX_BATCH:,}"),
+                       default=100, help=f"runs in the batched case (default 100, at most {MAX_BATCH:,})")
     bench.add_argument("--workers", type=arguments.workers, default=None, help="sweep workers (default: all cores)")
     bench.set_defaults(func=_cmd_bench)

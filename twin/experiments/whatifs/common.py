@@ -30,6 +30,13 @@ def list_flag(args: argparse.Namespace, flag: str, attribute: str, axis: str) ->
     return values
 
 
+def refuse_oversized(runs: int, what: str) -> None:
+    """A what-if of more than :data:`twin.batch.grid.MAX_POINTS` runs, the most a sweep takes, refused before
+    anything is built or written, naming ``what`` sets its size ("--periods x --seeds")."""
+    if runs > grid.MAX_POINTS:
+        raise InvalidScenario(f"{what} would make {runs:,} runs: more than the {grid.MAX_POINTS:,} a what-if takes")
+
+
 def number_list(text: str, flag: str, what: str, convert=float) -> list:
     """``flag``'s comma-separated values, each through ``convert``, without repeats, sorted; a one-line error
     naming ``flag`` and ``what`` it takes ("--phis: numbers in m/s separated by commas, got '0.2,,0.3'") for an

@@ -13,7 +13,13 @@ import numpy as np
 
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import THESIS_PAYLOADS_G
-from twin.experiments.whatifs.common import add_common_arguments, batch_progress, list_flag, progress_bar
+from twin.experiments.whatifs.common import (
+    add_common_arguments,
+    batch_progress,
+    list_flag,
+    progress_bar,
+    refuse_oversized,
+)
 from twin.physics import friction
 from twin.physics.model import Orientation
 from twin.physics.params import NOMINAL_PARAMS, JointParams
@@ -24,6 +30,7 @@ from viz.figures import finish, plt
 LIFT_SPAN_DEG = (80.0, 100.0)  # the lift must pass the horizontal link position
 THESIS_PAYLOAD = THESIS_PAYLOADS_G[-1] * 1e-3  # kg, the heaviest payload of the robustness study
 PAYLOAD_COLUMN = f"lifts_{THESIS_PAYLOAD * 1e3:g}g"  # true where a run with that payload passed the span
+LIFT_TOLERANCE = 0.005  # the bisection stops within this fraction of each pressure's closed-form lift
 
 
 def lift_limit_closed_form(params: JointParams, supply_pressure: float) -> float:
@@ -87,7 +94,15 @@ def _bisection_steps(closed: np.ndarray, can: np.ndarray, tolerance: float) -> i
     return steps
 
 
-def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", tolerance: float = 0.005,
+def planned_runs(pressures_kpa: Sequence[float], plant_name: str, tolerance: float = LIFT_TOLERANCE) -> int:
+    """The most runs :func:`lift_study` makes: the bare link and the thesis payload at every pressure, then every
+    bisection step at each pressure whose closed form lifts anything."""
+    params = plant(plant_name).params
+    closed = np.array([lift_limit_closed_form(params, p * 1e3) for p in np.unique(np.array(pressures_kpa, dtype=float))])
+    return 2 * closed.size + int(np.sum(closed > 0)) * _bisection_steps(closed, closed > 0, tolerance)
+
+
+def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", tolerance: float = LIFT_TOLERANCE,
                bar=None) -> Outcome:
     """``bar`` (a tqdm bar, optional) is given the number of scenarios before any runs, then counts them."""
     params = plant(plant_name).params
@@ -95,7 +110,7 @@ def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", to
     n = len(pressures)
     closed = np.array([lift_limit_closed_form(params, p) for p in pressures])
     if bar is not None:  # the bare link and the thesis payload at every pressure, then the bisection (at most)
-        bar.reset(total=2 * n + int(np.sum(closed > 0)) * _bisection_steps(closed, closed > 0, tolerance))
+        bar.reset(total=planned_runs(pressures_kpa, plant_name, tolerance))
 
     def lifts(payloads: np.ndarray, at: np.ndarray) -> np.ndarray:
         return _lifts(payloads, at, plant_name, progress=batch_progress(bar, len(at)))
@@ -162,6 +177,7 @@ class LiftWhatIf(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         args.pressure_values = list_flag(args, "--pressures", "pressures", "supply_kpa")
+        refuse_oversized(planned_runs(args.pressure_values, args.plant), "--pressures")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

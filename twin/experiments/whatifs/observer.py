@@ -21,7 +21,7 @@ import numpy as np
 
 import twin.experiments.whatifs.ensemble as ensemble
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import progress_bar
+from twin.experiments.whatifs.common import progress_bar, refuse_oversized
 from twin.physics.params import OBSERVER_KINDS
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import finish_panels, plt
@@ -29,6 +29,7 @@ from viz.figures import finish_panels, plt
 COLUMNS = ("controller", "trajectory", "observer", "velocity_rms_error_mm_s", "rmse_mean_deg", "band_p10", "band_p90",
            "acceleration_rms_error_m_s2")
 TRAJECTORIES = (1, 2, 3, 4)
+CONTROLLERS = ("ffpva", "smc")
 
 
 def with_observer(plant, kind: str):
@@ -51,7 +52,7 @@ def observer_batch(plant, cases: tuple, seeds: tuple) -> dict:
 
 
 def observer_study(*, seeds: int = 3, members: int | None = None, workers: int = 2, bar=None) -> Outcome:
-    cases = [(c, t, kind) for c in ("ffpva", "smc") for t in TRAJECTORIES for kind in OBSERVER_KINDS]
+    cases = [(c, t, kind) for c in CONTROLLERS for t in TRAJECTORIES for kind in OBSERVER_KINDS]
     seed_list = tuple(range(seeds))
     per_member, count = ensemble.run_cases(observer_batch, cases, seeds=seed_list, members=members, workers=workers,
                                            bar=bar)
@@ -134,6 +135,9 @@ class ObserverWhatIf(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         ensemble.check_members(args.members)
+        members = ensemble.member_count() if args.members is None else args.members
+        refuse_oversized(len(CONTROLLERS) * len(TRAJECTORIES) * len(OBSERVER_KINDS) * args.seeds * members,
+                         "--seeds x --members")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

@@ -14,9 +14,11 @@ from twin.batch.sweep import run_sweep
 from twin.batch.tables import summarise
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import add_common_arguments, list_flag, progress_bar
+from twin.experiments.whatifs.common import add_common_arguments, list_flag, progress_bar, refuse_oversized
 from viz.sweep_plots import plot_summary
 
+CONTROLLERS = ("ffpva", "smc")
+ORIENTATIONS = ("horizontal", "vertical")
 FOLLOW_LIMIT_DEG = 10.0  # max |error| beyond which the joint "no longer follows"
 
 
@@ -24,8 +26,8 @@ def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory:
                   plant_name: str = "thesis", workers: int | None = None, bar=None) -> Outcome:
     """``bar`` (a tqdm bar, optional) is given the number of scenarios before they run, then counts them
     (a resumed study counts the ones already in ``out`` at once)."""
-    points = expand({"controller": ["ffpva", "smc"], "trajectory": [trajectory], "payload": list(payloads_g),
-                     "orientation": ["horizontal", "vertical"], "plant": [plant_name], "seed": list(range(seeds))})
+    points = expand({"controller": list(CONTROLLERS), "trajectory": [trajectory], "payload": list(payloads_g),
+                     "orientation": list(ORIENTATIONS), "plant": [plant_name], "seed": list(range(seeds))})
     if bar is not None:
         bar.reset(total=len(points))
     records = run_sweep(points, out=out, workers=workers, progress=None if bar is None else bar.update).records
@@ -60,6 +62,8 @@ class PayloadWhatIf(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         args.payload_values = list_flag(args, "--payloads", "payloads", "payload")
+        refuse_oversized(len(CONTROLLERS) * len(set(args.payload_values)) * len(ORIENTATIONS) * args.seeds,
+                         "--payloads x --seeds")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         store = self.store(out)

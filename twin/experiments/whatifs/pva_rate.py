@@ -21,7 +21,7 @@ import numpy as np
 import twin.experiments.whatifs.ensemble as ensemble
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import number_list, progress_bar
+from twin.experiments.whatifs.common import number_list, progress_bar, refuse_oversized
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import finish_panels, plt
 
@@ -188,6 +188,9 @@ class PvaRateWhatIf(Experiment):
     def check(self, args: argparse.Namespace) -> None:
         args.rate_values = parse_rates(args.rates)
         ensemble.check_members(args.members)
+        members = ensemble.member_count() if args.members is None else args.members
+        refuse_oversized(len(ensemble.study_cells()) * len(args.rate_values) * args.seeds * members,
+                         "--rates x --seeds x --members")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

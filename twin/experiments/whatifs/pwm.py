@@ -11,12 +11,20 @@ from collections.abc import Sequence
 
 from twin.batch.tables import summarise
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import add_common_arguments, batch_progress, list_flag, progress_bar
+from twin.experiments.whatifs.common import (
+    add_common_arguments,
+    batch_progress,
+    list_flag,
+    progress_bar,
+    refuse_oversized,
+)
 from twin.physics.valves import ValveModel
 from twin.plants import Plant, plant
 from twin.sim import report
 from twin.sim.scenario import MODEL_BASED_CONTROLLERS, Scenario
 from viz.figures import finish, plt
+
+TRAJECTORIES = (1, 3)  # the robustness study's pair: a point-to-point move and the sine
 
 
 def _pwm_setup(base: Plant) -> str:
@@ -37,7 +45,7 @@ def _pwm_setup(base: Plant) -> str:
             f"PVA inside the PWM period) and is not mixed in here.{dead_zone}")
 
 
-def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = (1, 3), seeds: int = 3,
+def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = TRAJECTORIES, seeds: int = 3,
               plant_name: str = "thesis-pwm", bar=None) -> Outcome:
     """RMSE against the valves' PWM period, with the controllers' periods fixed at the base plant's
     (16 ms): one batch, controllers shared across scenarios, built from the base plant rather than from
@@ -96,6 +104,8 @@ class PwmWhatIf(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         args.period_values = list_flag(args, "--periods", "periods", "pwm_period_ms")
+        refuse_oversized(len(MODEL_BASED_CONTROLLERS) * len(TRAJECTORIES) * args.seeds * len(set(args.period_values)),
+                         "--periods x --seeds")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

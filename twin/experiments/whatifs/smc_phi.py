@@ -21,7 +21,13 @@ from twin.exceptions import InvalidScenario
 from twin.experiments.arguments import seed_count
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.validate import RMSE_TOLERANCE
-from twin.experiments.whatifs.common import add_common_arguments, batch_progress, number_list, progress_bar
+from twin.experiments.whatifs.common import (
+    add_common_arguments,
+    batch_progress,
+    number_list,
+    progress_bar,
+    refuse_oversized,
+)
 from twin.sim.metrics import spread
 from viz.figures import finish_panels, plt
 
@@ -182,6 +188,8 @@ class SmcPhiWhatIf(Experiment):
         from twin.plants import plant
 
         args.phi_values = parse_phis(args.phis)
+        laws = len(args.phi_values) + 2  # at most: the plant's own phi is added if not given, and FF + PVA
+        refuse_oversized(laws * len(measured_cells()) * args.seeds, "--phis x --seeds")
         if plant(args.plant).gain_set != "experiment":
             raise InvalidScenario(f"--plant {args.plant} runs the thesis's simulation gains; smc-phi compares with the "
                                   "rig's measurements, so it needs a plant with the experiment gains (as-built)")
