@@ -883,3 +883,24 @@ def test_a_stop_while_a_set_is_renamed_in_waits_until_the_whole_set_is_in(tmp_pa
     finally:
         for signum, handler in before.items():
             signal.signal(signum, handler)
+
+
+def test_a_folder_in_the_way_of_an_output_file_is_refused_and_no_file_of_the_set_moves(tmp_path, capsys):
+    """Found by probing (2026-11-27): with a folder named like one of a set's files, the files before it were
+    already renamed in when the rename onto the folder failed, and the error named the staging folder. Now
+    staged() checks every name first, and a what-if checks its usual names before it runs."""
+    from twin.experiments.base import staged
+
+    (tmp_path / "b.png").mkdir()
+    (tmp_path / "a.csv").write_text("old")
+    with pytest.raises(IsADirectoryError, match="a folder is in the way") as error, staged(tmp_path, "x") as stage:
+        for name in ("a.csv", "b.png"):
+            (stage.folder / name).write_text("new")
+            stage.names.append(name)
+    assert error.value.filename == str(tmp_path / "b.png")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["a.csv", "b.png"] and (tmp_path / "a.csv").read_text() == "old"
+    out = tmp_path / "out"
+    (out / "gear-load.png").mkdir(parents=True)
+    assert _exit_code(["whatif", "gear-load", "--out", str(out)]) == 2
+    _one_line_error(capsys, f"cannot write {out / 'gear-load.png'}: a folder is in the way of this file")
+    assert [p.name for p in out.iterdir()] == ["gear-load.png"]

@@ -7,6 +7,7 @@ import argparse
 import sys
 
 from twin.cli.common import EXIT_INTERRUPTED, Parser, output_folder
+from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, tell_undrawn
 from twin.experiments.studies import STUDIES
@@ -19,6 +20,10 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
     again, while it still holds the folder's lock, when it stops without its results, unless the
     experiment is resumable (its store may hold finished runs, whatever stopped it)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
+    for suffix in ("csv", "txt", "png"):  # the usual outputs; staged() checks every one before any moves in
+        if (args.out / f"{experiment.name}.{suffix}").is_dir():
+            raise InvalidScenario(f"cannot write {args.out / f'{experiment.name}.{suffix}'}: a folder is in the way "
+                                  "of this file")
     with output_folder(args.out, keep_on_failure=experiment.resumable):
         try:
             outcome = experiment.run(args, args.out)

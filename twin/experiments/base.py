@@ -125,6 +125,9 @@ def staged(out: pathlib.Path, prefix: str):
     stage = Staging(pathlib.Path(tempfile.mkdtemp(prefix=f".{prefix}-", dir=out)))
     try:
         yield stage
+        for name in stage.names:  # a folder where a file goes: refused before any file of the set moves
+            if (out / name).is_dir():
+                raise IsADirectoryError(errno.EISDIR, "a folder is in the way of this file", str(out / name))
     except BaseException:
         shutil.rmtree(stage.folder, ignore_errors=True)
         raise
