@@ -12,6 +12,7 @@ import pytest
 
 from twin.cli import main
 from twin.exceptions import InvalidScenario
+from twin.experiments.reference import ROBUSTNESS_CELLS
 from twin.experiments.whatifs import next_experiment, observer, pva_rate
 from twin.plants import plant
 
@@ -170,3 +171,31 @@ def test_open_question_commands_refuse_bad_input_and_write_nothing(tmp_path, cap
     err = capsys.readouterr().err
     assert flag in err and len(err.strip().splitlines()) == 1
     assert not out.exists() or not any(out.iterdir())
+
+
+def test_next_experiment_recommends_nothing_when_no_experiment_narrows_the_bands():
+    """Found by probing (2026-11-27): with every band kept whole it still named one experiment "most" narrowing.
+    Here each experiment keeps its bands (after = before), then one narrows them by half."""
+    cells = len(ROBUSTNESS_CELLS)
+    summary = {name: {"before": np.ones(cells), "after": np.ones(cells), "sigma": 0.1,
+                      "values": np.ones((3, 2))} for name in next_experiment.EXPERIMENTS}
+    hours = dict.fromkeys(next_experiment.EXPERIMENTS, 2.0)
+    trials = {"breakaway-map": 10.0, "loaded-breakaway-map": 12.0}
+
+    def answer() -> str:
+        return next(line for line in next_experiment._answer(summary, hours, members=3, seeds=2, prediction_seeds=1,
+                                                             pressure_step=10e3, trials=trials).splitlines()
+                    if line.startswith("Answer:"))
+
+    assert answer().startswith("Answer: none of these experiments narrows the predictions here")
+    summary["slow-sine"]["after"] = np.full(cells, 0.5)
+    assert answer() == "Answer: run the slow-sine experiment next: it narrows the predictions most per hour of rig time."
+
+
+def test_pwm_says_when_the_period_changes_nothing():
+    """The averaged valve ignores the period (but for the duty's resolution, which 8 and 16 ms share here): no
+    period is "best" (found by probing, 2026-11-27)."""
+    from twin.experiments.whatifs.pwm import pwm_study
+
+    text = pwm_study(periods_ms=[8.0, 16.0], seeds=1, plant_name="thesis-continuous").answer
+    assert "best" not in text and text.count(": the same at every period (") == 4

@@ -210,7 +210,7 @@ def test_a_validate_folder_can_be_scored_in_place_of_the_committed_prediction(tm
     # A broken folder is a one-line error, not a score.
     cells, members = (folder / "prediction.csv").read_text(), (folder / "prediction_members.csv").read_text()
     for name, content, message in (
-            ("prediction.csv", cells.replace(",2.0,1.9,", ",nan,1.9,", 1), "twin_mean must be a number"),
+            ("prediction.csv", cells.replace(",2.0,1.9,", ",nan,1.9,", 1), "twin_mean must be a finite number, got 'nan'"),
             ("prediction_members.csv", members.replace(",1,", ",0,", 1), "member 0 of the cell is given twice"),
             ("prediction_members.csv", "".join(members.splitlines(keepends=True)[:-1]),
              "does not give every T3 cell the same members")):

@@ -107,7 +107,8 @@ def _number(text: str, where: str, column: str, *, low: float = 0.0) -> float:
     except ValueError:
         value = math.nan
     if not math.isfinite(value) or value < low:
-        raise InvalidScenario(f"{where}: {column} must be a number of at least {low:g}, got {text!r}")
+        bound = "a finite number" if low == -math.inf else f"a number of at least {low:g}"
+        raise InvalidScenario(f"{where}: {column} must be {bound}, got {text!r}")
     return value
 
 

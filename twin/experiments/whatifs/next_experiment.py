@@ -267,7 +267,11 @@ def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_
             f"(widest cell {cell_label(ROBUSTNESS_CELLS[widest])}: {before[widest]:.2f} -> "
             f"{after[widest]:.2f} deg); rig time {hours[name]:.1f} h; narrowing {score[name]:.2f} per hour.")
     best = max(score, key=score.get)
-    lines.append(f"Answer: run the {best} experiment next: it narrows the predictions most per hour of rig time.")
+    if score[best] > 0:
+        lines.append(f"Answer: run the {best} experiment next: it narrows the predictions most per hour of rig time.")
+    else:
+        lines.append("Answer: none of these experiments narrows the predictions here (each keeps its bands' whole "
+                     "width), so none is worth its rig time by this measure; more members or seeds may tell them apart.")
     lines.append(f"Assumed: supply steps of {pressure_step / 1e3:g} kPa from {LADDER_START / 1e3:g} kPa (the "
                  f"air-over-water supply set by its air regulator; not finer), {len(MAP_ANGLES_DEG)} rest positions "
                  f"20-160 deg ({LOADED_PAYLOAD * 1e3:g} g on the link, vertical, for the loaded map), "

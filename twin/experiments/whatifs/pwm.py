@@ -73,7 +73,10 @@ def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = TRAJ
             group = sorted((r for r in rows if r["controller"] == controller and r["trajectory"] == t),
                            key=lambda r: r["pwm_period_ms"])
             best = min(group, key=lambda r: r["rmse_mean_deg"])
-            lines.append(f"{controller} T{t}: best {best['pwm_period_ms']:g} ms ({best['rmse_mean_deg']:.2f} deg); "
+            alike = len({r["rmse_mean_deg"] for r in group}) == 1
+            lines.append(f"{controller} T{t}: "
+                         + (f"the same at every period ({best['rmse_mean_deg']:.2f} deg); " if alike else
+                            f"best {best['pwm_period_ms']:g} ms ({best['rmse_mean_deg']:.2f} deg); ")
                          + ", ".join(f"{r['pwm_period_ms']:g} ms {r['rmse_mean_deg']:.2f}" for r in group))
     return Outcome(rows, "\n".join(lines))
 
