@@ -170,6 +170,20 @@ def test_a_store_of_another_code_version_is_refused(tmp_path, monkeypatch):
         run_sweep(points, out=tmp_path, workers=1)
 
 
+@pytest.mark.parametrize("table, columns", [("results", "(key, value)"), ("meta", "(a, b, c)")])
+def test_an_sqlite_file_of_something_else_is_refused_unwritten(tmp_path, table, columns):
+    """Found by probing (2026-11-27): a results.sqlite of another program whose results table was empty got this
+    twin's version stamped into it, then failed with a traceback. It is now refused before any write."""
+    path = tmp_path / "results.sqlite"
+    with sqlite3.connect(path) as db:
+        db.execute(f"CREATE TABLE {table} {columns}")
+    db.close()
+    before = path.read_bytes()
+    with pytest.raises(StaleStore, match=f"is not a results store of this twin \\(its {table} table has other columns"):
+        ResultStore(path, version="a")
+    assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["results.sqlite"]
+
+
 def test_a_store_without_a_version_but_with_results_is_refused(tmp_path):
     path = tmp_path / "results.sqlite"
     store = ResultStore(path, version="a")

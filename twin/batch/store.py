@@ -32,6 +32,11 @@ class ResultStore:
         self.path = path
         try:
             self._db = sqlite3.connect(path)
+            foreign = self._foreign_tables()
+            if foreign:
+                self._db.close()
+                raise StaleStore(f"{path} is not a results store of this twin (its {foreign} table has other "
+                                 "columns): use a new --out folder")
             self._db.execute("PRAGMA journal_mode=WAL")
             with self._db:
                 self._db.execute(f"CREATE TABLE IF NOT EXISTS results ({', '.join(COLUMNS)}, PRIMARY KEY (key))")
@@ -43,6 +48,16 @@ class ResultStore:
         except StaleStore:
             self._db.close()
             raise
+
+    def _foreign_tables(self) -> str | None:
+        """The first of ``results`` and ``meta`` that the file holds with other columns than this store's (an
+        SQLite file of something else), read before anything is written to it."""
+        expected = {"results": list(COLUMNS), "meta": ["name", "value"]}
+        for table, columns in expected.items():
+            found = [row[1] for row in self._db.execute(f"PRAGMA table_info({table})")]
+            if found and found != columns:
+                return table
+        return None
 
     def _claim(self, version: str) -> None:
         """Record ``version`` in a new store; refuse a store that holds another's results."""
