@@ -772,6 +772,36 @@ def test_a_sweep_on_ray_without_ray_is_one_line_before_anything(tmp_path, capsys
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("extra, words", [
+    (["--backend", "ray", "--ray-address", "127.0.0.1:1"], "--ray-address: cannot reach a Ray cluster at 127.0.0.1:1"),
+    (["--backend", "ray", "--ray-address", "head"], "--ray-address: HOST:PORT, ray://HOST:PORT, auto or local"),
+    (["--backend", "ray", "--ray-address", "ray://head:99999"], "--ray-address: HOST:PORT"),
+    (["--ray-address", "127.0.0.1:6379"], "--ray-address: only with --backend ray"),
+])
+def test_a_ray_address_that_cannot_be_reached_is_one_line_before_anything(tmp_path, capsys, extra, words):
+    """Found by probing (2026-11-27): a wrong --ray-address left the sweep at 0 of 1 for minutes while Ray
+    retried, and without --backend ray the address was silently ignored."""
+    assert main(["sweep", "--seed", "0", *extra, "--out", str(tmp_path / "s")]) == 2
+    _one_line_error(capsys, words)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_ray_failing_to_connect_is_not_read_as_a_file_that_cannot_be_written(monkeypatch):
+    """Ray's ConnectionError is an OSError, which the command line reads as an unwritable output."""
+    import ray
+
+    from twin.batch import grid, sweep
+
+    def refuse(**_):
+        raise ConnectionError("Could not find any running Ray instance.\nmore")
+
+    monkeypatch.setattr(ray, "is_initialized", lambda: False)
+    monkeypatch.setattr(ray, "init", refuse)
+    with pytest.raises(sweep.ClusterUnreachable, match="^cannot reach a Ray cluster at auto: Could not find any "
+                                                       "running Ray instance.$"):
+        sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)
+
+
 @pytest.mark.slow  # over ~2.5 s on 2 cores: two sweeps
 def test_a_sweep_whose_plot_fails_writes_its_tables(tmp_path, capsys, monkeypatch):
     import viz.sweep_plots

@@ -40,6 +40,10 @@ STORE_FORMAT = 2  # bump when a key or a column changes meaning
 PYPROJECT = pathlib.Path(__file__).resolve().parents[2] / "pyproject.toml"  # only in a source tree
 
 
+class ClusterUnreachable(TwinError):
+    """Ray could not connect to the cluster it was pointed at."""
+
+
 class WorkerLost(TwinError):
     """A worker process died mid-sweep (killed, or out of memory)."""
 
@@ -209,8 +213,11 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
 
     started_here = not ray.is_initialized()
     if started_here:  # log_to_driver=False: worker prints would flood the progress bar
-        ray.init(address=address or os.environ.get("RAY_ADDRESS") or None, include_dashboard=False,
-                 log_to_driver=False)
+        where = address or os.environ.get("RAY_ADDRESS") or None
+        try:
+            ray.init(address=where, include_dashboard=False, log_to_driver=False)
+        except ConnectionError as error:  # an OSError, which would read as a file that cannot be written
+            raise ClusterUnreachable(f"cannot reach a Ray cluster at {where}: {str(error).splitlines()[0]}") from None
     pending = []
     try:
         cpus = workers or int(ray.cluster_resources().get("CPU", 1))

@@ -31,10 +31,34 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.backend == "ray" and importlib.util.find_spec("ray") is None:
         raise InvalidScenario("--backend ray: Ray is not installed here (pip install 'ray[default]'), "
                               "or use --backend local")
+    if args.ray_address is not None:
+        if args.backend != "ray":
+            raise InvalidScenario("--ray-address: only with --backend ray (this sweep would run locally)")
+        check_ray_address(args.ray_address)
     # one writer per folder (a second sweep into it is refused, naming this one); SIGTERM stops it as Ctrl-C
     # does; the folder stays whatever stops the sweep: its store keeps the finished scenarios
     with output_folder(args.out, keep_on_failure=True):
         return _sweep(args, points)
+
+
+RAY_CONNECT_TIMEOUT = 5.0  # s to reach a cluster's head before the sweep is refused (Ray itself retries for minutes)
+
+
+def check_ray_address(address: str) -> None:
+    """``--ray-address`` ``HOST:PORT`` (or ``ray://HOST:PORT``) must answer a TCP connection within
+    :data:`RAY_CONNECT_TIMEOUT`, else a one-line error before anything is written: Ray's own connect retries
+    for minutes with no error (found by probing, 2026-11-27). ``auto`` and ``local`` are left to Ray."""
+    import socket
+
+    if address in ("auto", "local"):
+        return
+    host, _, port = address.removeprefix("ray://").rpartition(":")
+    if not host or not port.isdigit() or not 0 < int(port) < 65536:
+        raise InvalidScenario(f"--ray-address: HOST:PORT, ray://HOST:PORT, auto or local, got {address!r}")
+    try:
+        socket.create_connection((host.strip("[]"), int(port)), timeout=RAY_CONNECT_TIMEOUT).close()
+    except OSError as error:
+        raise InvalidScenario(f"--ray-address: cannot reach a Ray cluster at {address} ({error.strerror or error})") from None
 
 
 def _sweep(args: argparse.Namespace, points: list) -> int:
