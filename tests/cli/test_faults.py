@@ -161,6 +161,26 @@ def test_every_command_errors_with_one_prefix(argv, capsys, tmp_path, monkeypatc
     assert list(tmp_path.iterdir()) == []
 
 
+@pytest.mark.parametrize("argv, words", [
+    (["sweep", "--seed", "0", "--without", "stiction", "--out", "x"], "sweep: unrecognized arguments: --without stiction"),
+    (["whatif", "gear-load", "--out", "x", "--bogus"], "whatif gear-load: unrecognized arguments: --bogus")])
+def test_an_unknown_flag_is_named_after_its_command(argv, words, capsys, tmp_path, monkeypatch):
+    """Every other parse error names its command; unrecognized flags did not (found by probing, 2026-11-27)."""
+    monkeypatch.chdir(tmp_path)
+    assert _exit_code(argv) == 2
+    _one_line_error(capsys, f"twin: error: {words}")
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_the_demo_table_shows_no_negative_zero_and_one_seed_as_one():
+    from twin.experiments import demo
+
+    row = {"controller": "ffpva", "trajectory": 1, "rmse_mean": 0.5, "rmse_std": 0.0, "thesis_rmse": 0.5 + 1e-4,
+           "sse_mean": -1e-4, "sse_min": -0.004, "sse_max": 0.0, "thesis_sse": 0.35, "max_error_mean": 1.0}
+    table = demo.markdown_table([row])
+    assert "-0.00" not in table and "| +0.00 | +0.00 [+0.00, +0.00] |" in table
+
+
 def _sweep_argv(out: pathlib.Path) -> list[str]:
     """A sweep long enough to be stopped part-way: 480 as-built scenarios on 2 workers (about 1 min)."""
     return [sys.executable, "-m", "twin", "sweep", "--controller", "ffpva,smc", "--trajectory", "1,3",

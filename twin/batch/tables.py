@@ -78,9 +78,13 @@ def write_summary(summary: Sequence[dict], out: pathlib.Path) -> None:
     write_csv(summary, SUMMARY_COLUMNS, out / "summary.csv")
 
 
-def _hundredths(value: float) -> str:
+def signed(value: float, width: int = 0) -> str:
     """Signed to 0.01, with a value that rounds to zero shown as +0.00, not -0.00."""
-    return f"{round(value, 2) + 0.0:+6.2f}"
+    return f"{round(value, 2) + 0.0:+{width}.2f}"
+
+
+def _hundredths(value: float) -> str:
+    return signed(value, 6)
 
 
 def format_summary(summary: Sequence[dict], limit: int = 40) -> str:

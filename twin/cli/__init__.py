@@ -37,7 +37,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     try:
-        args = build_parser().parse_args(argv)
+        parser = build_parser()
+        args, extra = parser.parse_known_args(argv)
+        if extra:  # named after the command they were given to, as every other parse error is
+            command = " ".join(filter(None, (args.command, getattr(args, "experiment", None))))
+            parser.exit(EXIT_USAGE, f"twin: error: {command}: unrecognized arguments: {' '.join(extra)}\n")
         return args.func(args)
     except KeyboardInterrupt:  # Ctrl-C where a command has nothing of its own to say: one line, no traceback
         print("twin: interrupted", file=sys.stderr)

@@ -22,6 +22,7 @@ import sys
 import numpy as np
 from tqdm import tqdm
 
+from twin.batch.tables import signed
 from twin.envs.runner import run_many
 from twin.experiments.base import staged, tell_undrawn
 from twin.experiments.reference import (
@@ -69,7 +70,7 @@ def _fmt(value, spec: str = ".2f") -> str:
 def _sse(row: dict) -> str:
     if np.isnan(row["sse_mean"]):
         return "– (ends moving)"
-    return f"{row['sse_mean']:+.2f} [{row['sse_min']:+.2f}, {row['sse_max']:+.2f}]"
+    return f"{signed(row['sse_mean'])} [{signed(row['sse_min'])}, {signed(row['sse_max'])}]"
 
 
 def rest_error_table(results: list[Result]) -> str:
@@ -81,7 +82,7 @@ def rest_error_table(results: list[Result]) -> str:
             continue
         mean = np.degrees(np.mean([r.metrics.rest_errors for r in runs], axis=0))
         thesis = THESIS_SIMULATED_T4_REST_ERRORS_DEG.get(c)
-        lines.append(f"| {CONTROLLER_LABELS[c]} | {', '.join(f'{e:+.2f}' for e in mean)} | "
+        lines.append(f"| {CONTROLLER_LABELS[c]} | {', '.join(signed(e) for e in mean)} | "
                      f"{', '.join(f'{e:+.2f}' for e in thesis) if thesis else '–'} |")
     return "\n".join(lines)
 
@@ -93,7 +94,7 @@ def markdown_table(rows: list[dict]) -> str:
         diff = None if r["thesis_rmse"] is None else r["rmse_mean"] - r["thesis_rmse"]
         lines.append(
             f"| {CONTROLLER_LABELS[r['controller']]} | T{r['trajectory']} | {r['rmse_mean']:.2f} ± {r['rmse_std']:.2f} | "
-            f"{_fmt(r['thesis_rmse'])} | {_fmt(diff, '+.2f')} | {_sse(r)} | "
+            f"{_fmt(r['thesis_rmse'])} | {'–' if diff is None else signed(diff)} | {_sse(r)} | "
             f"{_fmt(r['thesis_sse'])} | {r['max_error_mean']:.2f} |")
     return "\n".join(lines)
 
@@ -131,7 +132,7 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
                     writer = csv.DictWriter(handle, fieldnames=list(record))
                     writer.writeheader()
                 writer.writerow(record)
-        (stage.folder / "summary.md").write_text(f"{SUMMARY_TITLE} ('thesis' plant, {seeds} seeds)\n\n{table}\n")
+        (stage.folder / "summary.md").write_text(f"{SUMMARY_TITLE} ('thesis' plant, {seeds} seed{'' if seeds == 1 else 's'})\n\n{table}\n")
         stage.names += ["results.csv", "summary.md"]
         if plots:
             from viz.plots import plot_run
