@@ -88,6 +88,17 @@ def test_compare_settings_become_scenario_changes():
     assert scenario.supply == pytest.approx(250e3)
 
 
+def test_an_as_built_joint_with_effects_off_compares_with_another_plant():
+    """``--without`` belongs to the as-built plant: a compared plant that is not as-built drops it (it was refused,
+    "use --plant as-built", though the user had; found by probing, 2026-11-27), one that is keeps it."""
+    args = build_parser().parse_args(["run", "--controller", "smc", "--trajectory", "1", "--plant", "as-built",
+                                      "--without", "stiction", "--compare", "plant=thesis"])
+    assert compare_of(args, args.compare).applied(Scenario("smc", 1)).plant_name == "thesis"
+    args = build_parser().parse_args(["run", "--controller", "smc", "--trajectory", "1", "--plant", "thesis",
+                                      "--compare", "plant=as-built,without=stiction"])
+    assert compare_of(args, args.compare).applied(Scenario("smc", 1)).plant_name == "as-built-without-stiction"
+
+
 @pytest.mark.parametrize("text, complaint", [
     ("foo=bar", "key 'foo' cannot be compared"),
     ("payload=abc", "key 'payload': payload must be a non-negative number of grams"),

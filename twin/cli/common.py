@@ -104,6 +104,8 @@ def compare_of(args: argparse.Namespace, settings: dict[str, str]):
     for key in settings:
         dest = key.replace("-", "_")
         setattr(merged, dest, getattr(parsed, dest))
+    if "plant" in settings and "without" not in settings and merged.plant != "as-built":
+        merged.without = None  # --without is the as-built plant's: another plant compared drops it
     try:
         scenario = scenario_from(merged)
     except InvalidScenario as error:

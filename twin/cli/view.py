@@ -49,7 +49,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
 def add_parser(sub) -> None:
     view = sub.add_parser("view", help="the joint live in a browser (3D view and control panel)")
     add_scenario_arguments(view)
-    view.add_argument("--host", default="127.0.0.1", help="address to listen on (default 127.0.0.1 only)")
+    view.add_argument("--host", type=arguments.host, default="127.0.0.1", help="address to listen on (default 127.0.0.1 only)")
     view.add_argument("--port", type=arguments.port, default=7000, help="TCP port (default 7000; 0: any free port)")
     view.add_argument("--speed", type=arguments.speed, default=1.0, help="simulated seconds per second (default 1)")
     view.add_argument("--duration", type=arguments.seconds, default=None, metavar="SECONDS",
