@@ -63,6 +63,14 @@ def test_a_range_over_the_cap_is_refused_with_its_size_before_any_value_is_made(
     assert len(grid.parse_axis("payload", "1:100000:1")) == 100_000  # the cap itself is allowed
 
 
+@pytest.mark.parametrize("name, value", [("payload", ",".join(["0:99999:1"] * 3)), ("seed", "0-60000,70000-130000")])
+def test_many_ranges_each_under_the_cap_are_refused_together(name, value):
+    """Each range was checked alone, the total only once the grid was expanded: thirty ranges of 100,000 values
+    took 356 MB before the refusal (found by review, 2026-11-27)."""
+    with pytest.raises(InvalidScenario, match=f"--{name} has more than the 100,000 values a sweep takes"):
+        grid.parse_axis(name, value)
+
+
 @pytest.mark.parametrize("name, value", [("seed", "0,0"), ("payload", "0,0.0"), ("payload", "-0,0"),
                                          ("controller", "smc,smc")])
 def test_repeated_values_give_one_scenario(name, value):
@@ -170,7 +178,7 @@ def test_a_store_of_another_code_version_is_refused(tmp_path, monkeypatch):
         run_sweep(points, out=tmp_path, workers=1)
 
 
-@pytest.mark.parametrize("table, columns", [("results", "(key, value)"), ("meta", "(a, b, c)")])
+@pytest.mark.parametrize("table, columns", [("results", "(key, value)"), ("meta", "(a, b, c)"), ("users", "(id, name)")])
 def test_an_sqlite_file_of_something_else_is_refused_unwritten(tmp_path, table, columns):
     """Found by probing (2026-11-27): a results.sqlite of another program whose results table was empty got this
     twin's version stamped into it, then failed with a traceback. It is now refused before any write."""
@@ -179,7 +187,7 @@ def test_an_sqlite_file_of_something_else_is_refused_unwritten(tmp_path, table, 
         db.execute(f"CREATE TABLE {table} {columns}")
     db.close()
     before = path.read_bytes()
-    with pytest.raises(StaleStore, match=f"is not a results store of this twin \\(its {table} table has other columns"):
+    with pytest.raises(StaleStore, match=f"is not a results store of this twin \\(it holds a table '{table}' that"):
         ResultStore(path, version="a")
     assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["results.sqlite"]
 

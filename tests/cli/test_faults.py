@@ -3,6 +3,7 @@
 
 from __future__ import annotations
 
+import argparse
 import contextlib
 import csv
 import errno
@@ -466,16 +467,21 @@ def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, 
     (["sweep", "--payload", "0:1e300:1e-300", "--out", "OUT"], "has over a trillion values: more than the 100,000"),
     (["whatif", "lift", "--out", "OUT", "--pressures", "1:700:0.01"], "--pressures would make 1,179,938 runs"),
     (["whatif", "pwm", "--out", "OUT", "--periods", "4:100:1", "--seeds", "1000"],
-     "--periods x --seeds would make 388,000 runs: more than the 100,000 a what-if takes"),
+     "--periods x --seeds would make 388,000 runs: more than the 100,000 one command takes"),
     (["whatif", "smc-phi", "--out", "OUT", "--phis", ",".join(f"{k / 100:g}" for k in range(1, 301)), "--seeds",
-      "1000"], "--phis x --seeds would make 2,718,000 runs"),  # (300 + 2) laws x 9 cells x 1000
+      "1000"], "--phis x --seeds would make 2,709,000 runs"),  # (300, 0.3 among them, + FF + PVA) x 9 cells x 1000
     (["whatif", "pva-rate", "--out", "OUT", "--rates", ",".join(str(k) for k in range(1, 65)), "--seeds", "1000"],
      f"--rates x --seeds x --members would make {28 * 64 * 1000 * len(ensemble_values()):,} runs"),
     (["whatif", "observer", "--out", "OUT", "--seeds", "1000"],
      f"--seeds x --members would make {16 * 1000 * len(ensemble_values()):,} runs"),
     (["whatif", "payload", "--out", "OUT", "--payloads", "0:200:0.01", "--seeds", "1000"],
      "--payloads x --seeds would make 80,004,000 runs"),
-    (["bench", "--batch", "1000000"], "runs in the batch must be an integer from 1 to 10,000"),
+    (["whatif", "air", "--out", "OUT", "--air", "1,2,3,4,5,6,7,8,9,10", "--seeds", "1000"],
+     "--air x --seeds would make 134,310 runs"),  # 11 values x (21 cells x 10 fit seeds + 12 T3 cells x 1000)
+    (["study", "ablation", "--out", "OUT", "--seeds", "1000"], "--seeds would make 110,000 runs"),  # 10 x 11 x 1000
+    (["whatif", "next-experiment", "--out", "OUT", "--seeds", "1000", "--prediction-seeds", "1000", "--pressure-step",
+      "1"], f"would make up to {len(ensemble_values()) * (1000 * (2 * 8 * 9 + 1) + 1000 * 24):,} runs"),  # 9 rounds: 281 rungs
+    (["bench", "--batch", "1000000"], "runs in the batch must be an integer from 1 to 2,000"),
     (["view", "--controller", "smc", "--trajectory", "1", "--host", ""], "--host: give a host name or address"),
     (["whatif", "gear-load", "--out", ""], "the output folder must be named"),
     (["sweep", "--controller", "ffpva", "--trajectory", "1", "--out", ""], "the output folder must be named"),
@@ -488,6 +494,14 @@ def test_absurd_sizes_empty_names_and_loose_lists_are_refused_before_anything_ru
     runs; tens of thousands of seeds or workers were taken (gigabytes, thousands of processes); an empty
     list item, an empty --out (the current folder) and an unwritable folder that root's os.access calls
     writable were let through. Each is now one line, exit 2, and nothing in the folder."""
+    import twin.cli.experiments
+    import twin.cli.sweep
+
+    def began(*args, **kwargs):
+        raise AssertionError("a command that should be refused began its work")  # not hours of a huge run
+
+    monkeypatch.setattr(twin.cli.experiments, "output_folder", began)
+    monkeypatch.setattr(twin.cli.sweep, "output_folder", began)
     monkeypatch.chdir(tmp_path)
     argv = [str(tmp_path / "out") if a == "OUT" else a for a in argv]
     assert _exit_code(argv) == 2
@@ -798,10 +812,15 @@ def test_a_sweep_on_ray_without_ray_is_one_line_before_anything(tmp_path, capsys
     (["--backend", "ray", "--ray-address", "head"], "--ray-address: HOST:PORT, ray://HOST:PORT, auto or local"),
     (["--backend", "ray", "--ray-address", "ray://head:99999"], "--ray-address: HOST:PORT"),
     (["--ray-address", "127.0.0.1:6379"], "--ray-address: only with --backend ray"),
+    (["--backend", "ray", "RAY_ADDRESS=127.0.0.1:1"], "RAY_ADDRESS: cannot reach a Ray cluster at 127.0.0.1:1"),
 ])
-def test_a_ray_address_that_cannot_be_reached_is_one_line_before_anything(tmp_path, capsys, extra, words):
-    """Found by probing (2026-11-27): a wrong --ray-address left the sweep at 0 of 1 for minutes while Ray
-    retried, and without --backend ray the address was silently ignored."""
+def test_a_ray_address_that_cannot_be_reached_is_one_line_before_anything(tmp_path, capsys, monkeypatch, extra, words):
+    """Found by probing (2026-11-27): a wrong --ray-address (or RAY_ADDRESS) left the sweep at 0 of 1 for minutes
+    while Ray retried, and without --backend ray the address was silently ignored."""
+    monkeypatch.delenv("RAY_ADDRESS", raising=False)
+    for item in [e for e in extra if e.startswith("RAY_ADDRESS=")]:
+        monkeypatch.setenv("RAY_ADDRESS", item.split("=", 1)[1])
+        extra = [e for e in extra if e != item]
     assert main(["sweep", "--seed", "0", *extra, "--out", str(tmp_path / "s")]) == 2
     _one_line_error(capsys, words)
     assert list(tmp_path.iterdir()) == []
@@ -818,9 +837,30 @@ def test_ray_failing_to_connect_is_not_read_as_a_file_that_cannot_be_written(mon
 
     monkeypatch.setattr(ray, "is_initialized", lambda: False)
     monkeypatch.setattr(ray, "init", refuse)
-    with pytest.raises(sweep.ClusterUnreachable, match="^cannot reach a Ray cluster at auto: Could not find any "
-                                                       "running Ray instance.$"):
+    with pytest.raises(sweep.ClusterUnreachable, match="^lost or could not reach the Ray cluster at auto: Could not "
+                                                       "find any running Ray instance.$"):
         sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)
+    monkeypatch.setattr(ray, "is_initialized", lambda: True)  # connected; then the connection breaks mid-sweep
+    monkeypatch.setattr(ray, "cluster_resources", lambda: {"CPU": 1})
+    monkeypatch.setattr(ray, "remote", lambda function: type("Remote", (), {"remote": lambda self, chunk: chunk})())
+    monkeypatch.setattr(ray, "wait", lambda pending, num_returns: refuse())
+    monkeypatch.setattr(ray, "cancel", lambda ref: None)
+    with pytest.raises(sweep.ClusterUnreachable, match="^lost or could not reach the Ray cluster at auto"):
+        sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)
+
+
+def test_an_os_error_without_a_file_is_said_as_itself(capsys, monkeypatch):
+    """Only an OSError that names a file reads "cannot write FILE" (a failed fork said "cannot write : None")."""
+    import twin.cli as cli
+
+    def failing(args):
+        raise BlockingIOError(errno.EAGAIN, "Resource temporarily unavailable")
+
+    parser = cli.build_parser()
+    monkeypatch.setattr(cli, "build_parser", lambda: parser)
+    monkeypatch.setattr(parser, "parse_known_args", lambda argv: (argparse.Namespace(func=failing), []))
+    assert main(["bench"]) == 2
+    _one_line_error(capsys, "twin: error: [Errno 11] Resource temporarily unavailable")
 
 
 @pytest.mark.slow  # over ~2.5 s on 2 cores: two sweeps

@@ -120,6 +120,7 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     assert f"Prediction: the committed one, `twin validate` on as-built preset {preset_digest()}." in text
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["orders.csv", "score.csv", "score.md",
                                                                                     "score.png"]
+    assert sorted(score.EXPERIMENT.file_names()) == sorted(p.name for p in out.iterdir() if not p.name.startswith("."))
 
 
 @pytest.mark.parametrize("edit,message", [

@@ -63,6 +63,8 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
         assert int(r["stalled_runs"]) >= 0 and math.isfinite(float(r["twin_mean"]))
     report = (out / "validation.md").read_text(encoding="utf-8")
     assert "## Why, as far as the twin shows" in report and "## Prediction: Chapter 6 T3 (blind)" in report
+    # the names checked for folders in the way before a run are the files it writes
+    assert sorted(validate.EXPERIMENT.file_names()) == sorted(p.name for p in out.iterdir() if not p.name.startswith("."))
     assert "![T2's first run" in report
     columns, more = rows_of(out / "seeds.csv")
     assert columns == list(validate.SEED_COLUMNS) and len(more) == 21

@@ -359,3 +359,19 @@ def test_whatif_air_scores_as_the_fit_does_and_moves_the_air_alone(tmp_path):
         assert [(r["controller"], float(r["payload_g"]), r["orientation"]) for r in rows[12 * k:12 * k + 12]] == [
             (c, g, o) for c, _, g, o in PREDICTION_CELLS]
     assert "A what-if, not a fit" in (tmp_path / "air" / "air.txt").read_text()
+
+
+@pytest.mark.slow  # about 6 s: four small batches
+def test_a_what_if_simulated_in_parts_gives_the_numbers_of_one_batch(monkeypatch):
+    """Since 2026-11-27 the what-ifs simulate at most BATCH_RUNS runs at once (one batch of all of them ran out of
+    memory); each run is its own, so parts of 3 (or of 1 pair per ensemble batch) give the one batch's numbers."""
+    from twin.experiments.whatifs import common, ensemble
+    from twin.experiments.whatifs.pwm import pwm_study
+
+    whole = pwm_study(periods_ms=[8.0, 16.0], seeds=1, plant_name="thesis-pwm").rows
+    cases, seeds = ensemble.study_cells()[:2], (0, 1)
+    together = ensemble.over_ensemble(ensemble.cells_batch, cases, seeds=seeds, workers=1, members=1)
+    monkeypatch.setattr(common, "BATCH_RUNS", 3)
+    assert repr(pwm_study(periods_ms=[8.0, 16.0], seeds=1, plant_name="thesis-pwm").rows) == repr(whole)  # nan too
+    monkeypatch.setattr(common, "BATCH_RUNS", 1)
+    assert repr(ensemble.over_ensemble(ensemble.cells_batch, cases, seeds=seeds, workers=1, members=1)) == repr(together)

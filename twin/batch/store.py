@@ -35,8 +35,8 @@ class ResultStore:
             foreign = self._foreign_tables()
             if foreign:
                 self._db.close()
-                raise StaleStore(f"{path} is not a results store of this twin (its {foreign} table has other "
-                                 "columns): use a new --out folder")
+                raise StaleStore(f"{path} is not a results store of this twin (it holds a table {foreign!r} that "
+                                 "this store does not make): use a new --out folder")
             self._db.execute("PRAGMA journal_mode=WAL")
             with self._db:
                 self._db.execute(f"CREATE TABLE IF NOT EXISTS results ({', '.join(COLUMNS)}, PRIMARY KEY (key))")
@@ -50,12 +50,12 @@ class ResultStore:
             raise
 
     def _foreign_tables(self) -> str | None:
-        """The first of ``results`` and ``meta`` that the file holds with other columns than this store's (an
-        SQLite file of something else), read before anything is written to it."""
+        """The first table the file holds that this store would not make (another name, or ``results`` or
+        ``meta`` with other columns): an SQLite file of something else, found before anything is written."""
         expected = {"results": list(COLUMNS), "meta": ["name", "value"]}
-        for table, columns in expected.items():
-            found = [row[1] for row in self._db.execute(f"PRAGMA table_info({table})")]
-            if found and found != columns:
+        for (table,) in self._db.execute("SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name"):
+            found = [row[1] for row in self._db.execute(f"PRAGMA table_info({table!r})")]
+            if found != expected.get(table):
                 return table
         return None
 

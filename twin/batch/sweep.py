@@ -211,13 +211,19 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
         return  # no cluster to start
     import ray
 
+    where = address or os.environ.get("RAY_ADDRESS") or None
+    try:
+        _ray_tasks(ray, points, workers, where, on_done)
+    except ConnectionError as error:  # an OSError, which would read as a file that cannot be written
+        raise ClusterUnreachable(f"lost or could not reach the Ray cluster at {where or 'a local Ray'}: "
+                                 f"{str(error).splitlines()[0]}") from None
+
+
+def _ray_tasks(ray, points: Sequence[GridPoint], workers: int | None, where: str | None,
+               on_done: Callable[[list[dict]], None]) -> None:
     started_here = not ray.is_initialized()
     if started_here:  # log_to_driver=False: worker prints would flood the progress bar
-        where = address or os.environ.get("RAY_ADDRESS") or None
-        try:
-            ray.init(address=where, include_dashboard=False, log_to_driver=False)
-        except ConnectionError as error:  # an OSError, which would read as a file that cannot be written
-            raise ClusterUnreachable(f"cannot reach a Ray cluster at {where}: {str(error).splitlines()[0]}") from None
+        ray.init(address=where, include_dashboard=False, log_to_driver=False)
     pending = []
     try:
         cpus = workers or int(ray.cluster_resources().get("CPU", 1))

@@ -83,6 +83,11 @@ def signed(value: float, width: int = 0) -> str:
     return f"{round(value, 2) + 0.0:+{width}.2f}"
 
 
+def counted(n: int, noun: str) -> str:
+    """``n`` and ``noun``, plural unless one: "1 seed", "3 seeds"."""
+    return f"{n} {noun}{'' if n == 1 else 's'}"
+
+
 def _hundredths(value: float) -> str:
     return signed(value, 6)
 

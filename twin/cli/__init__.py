@@ -49,8 +49,10 @@ def main(argv: list[str] | None = None) -> int:
     except TwinError as error:
         print(f"twin: error: {error}", file=sys.stderr)
         return EXIT_USAGE
-    except OSError as error:  # an output that passed the checks but still cannot be written
-        print(f"twin: error: cannot write {error.filename or ''}: {error.strerror}", file=sys.stderr)
+    except OSError as error:  # an output that passed the checks but still cannot be written, or the system
+        said = (f"cannot write {error.filename}: {error.strerror}" if error.filename else
+                str(error).splitlines()[0] if str(error) else type(error).__name__)
+        print(f"twin: error: {said}", file=sys.stderr)
         return EXIT_USAGE
 
 

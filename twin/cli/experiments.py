@@ -20,10 +20,9 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
     again, while it still holds the folder's lock, when it stops without its results, unless the
     experiment is resumable (its store may hold finished runs, whatever stopped it)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
-    for suffix in ("csv", "txt", "png"):  # the usual outputs; staged() checks every one before any moves in
-        if (args.out / f"{experiment.name}.{suffix}").is_dir():
-            raise InvalidScenario(f"cannot write {args.out / f'{experiment.name}.{suffix}'}: a folder is in the way "
-                                  "of this file")
+    for name in experiment.file_names():  # staged() checks every file it writes again before any moves in
+        if (args.out / name).is_dir():
+            raise InvalidScenario(f"cannot write {args.out / name}: a folder is in the way of this file")
     with output_folder(args.out, keep_on_failure=experiment.resumable):
         try:
             outcome = experiment.run(args, args.out)

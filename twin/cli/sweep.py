@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
+import os
 import pathlib
 import sys
 
@@ -31,10 +32,11 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     if args.backend == "ray" and importlib.util.find_spec("ray") is None:
         raise InvalidScenario("--backend ray: Ray is not installed here (pip install 'ray[default]'), "
                               "or use --backend local")
-    if args.ray_address is not None:
-        if args.backend != "ray":
-            raise InvalidScenario("--ray-address: only with --backend ray (this sweep would run locally)")
-        check_ray_address(args.ray_address)
+    if args.ray_address is not None and args.backend != "ray":
+        raise InvalidScenario("--ray-address: only with --backend ray (this sweep would run locally)")
+    if args.backend == "ray" and (args.ray_address or os.environ.get("RAY_ADDRESS")):
+        check_ray_address(args.ray_address or os.environ["RAY_ADDRESS"],
+                          "--ray-address" if args.ray_address else "RAY_ADDRESS")
     # one writer per folder (a second sweep into it is refused, naming this one); SIGTERM stops it as Ctrl-C
     # does; the folder stays whatever stops the sweep: its store keeps the finished scenarios
     with output_folder(args.out, keep_on_failure=True):
@@ -44,7 +46,7 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 RAY_CONNECT_TIMEOUT = 5.0  # s to reach a cluster's head before the sweep is refused (Ray itself retries for minutes)
 
 
-def check_ray_address(address: str) -> None:
+def check_ray_address(address: str, source: str = "--ray-address") -> None:
     """``--ray-address`` ``HOST:PORT`` (or ``ray://HOST:PORT``) must answer a TCP connection within
     :data:`RAY_CONNECT_TIMEOUT`, else a one-line error before anything is written: Ray's own connect retries
     for minutes with no error (found by probing, 2026-11-27). ``auto`` and ``local`` are left to Ray."""
@@ -54,11 +56,11 @@ def check_ray_address(address: str) -> None:
         return
     host, _, port = address.removeprefix("ray://").rpartition(":")
     if not host or not port.isdigit() or not 0 < int(port) < 65536:
-        raise InvalidScenario(f"--ray-address: HOST:PORT, ray://HOST:PORT, auto or local, got {address!r}")
+        raise InvalidScenario(f"{source}: HOST:PORT, ray://HOST:PORT, auto or local, got {address!r}")
     try:
         socket.create_connection((host.strip("[]"), int(port)), timeout=RAY_CONNECT_TIMEOUT).close()
     except OSError as error:
-        raise InvalidScenario(f"--ray-address: cannot reach a Ray cluster at {address} ({error.strerror or error})") from None
+        raise InvalidScenario(f"{source}: cannot reach a Ray cluster at {address} ({error.strerror or error})") from None
 
 
 def _sweep(args: argparse.Namespace, points: list) -> int:

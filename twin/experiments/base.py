@@ -60,6 +60,11 @@ class Experiment:
     def check(self, args: argparse.Namespace) -> None:
         """Raise InvalidScenario for bad input, before any output exists."""
 
+    def file_names(self) -> tuple[str, ...]:
+        """The files :meth:`outputs` writes (``NAME.csv``, ``NAME.txt``, ``NAME.png`` unless it writes others), for
+        a check before the run that none is a folder (:func:`staged` checks what it actually wrote, again)."""
+        return (f"{self.name}.csv", f"{self.name}.txt", f"{self.name}.png")
+
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         raise NotImplementedError
 

@@ -392,6 +392,9 @@ class ScoreExperiment(Experiment):
                              prediction=committed_name() if args.prediction is None else f"`{args.prediction}`")
         return Outcome(rows=s["cells"], answer=answer(s), detail=s)
 
+    def file_names(self) -> tuple[str, ...]:
+        return ("score.csv", "orders.csv", "score.md", "score.png")
+
     def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
         """``score.csv`` (per cell), ``orders.csv``, ``score.md`` and ``score.png``."""
         s = outcome.detail

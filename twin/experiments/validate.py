@@ -36,7 +36,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from twin.batch.tables import write_csv
+from twin.batch.tables import signed, write_csv
 from twin.experiments import calibrate
 from twin.experiments.base import Experiment, Outcome, drawn
 from twin.experiments.reference import (
@@ -1153,7 +1153,7 @@ def _sse_reading(r: dict, f: dict | None, v: Validation) -> tuple[str, str]:
         f"out on seeds {f['seeds']}" + (" too" if not r["within_tolerance"] else "") + ", "
         + ("narrower" if f["sse_twin"] < r["measured"] else "wider") + " than the rig's (groups' ranges "
         f"±{f['sse_group_low']:.2f}-{f['sse_group_high']:.2f}, mean ±{f['sse_twin']:.2f}, against "
-        f"±{r['measured']:.2f}). The twin's runs end at {f['sse_mean']:+.2f} ± {f['sse_std']:.2f} deg "
+        f"±{r['measured']:.2f}). The twin's runs end at {signed(f['sse_mean'])} ± {f['sse_std']:.2f} deg "
         "(mean ± std), so its range is " + ("their scatter" if centred else "their offset as much as their scatter")
         + "; whether the rig's was scatter or an offset, its range does not tell"
         + (f". The same cell's payload cost on RMSE is short of the rig's (x{cost['twin_effect']:.2f} "
@@ -1925,6 +1925,10 @@ class ValidateExperiment(Experiment):
                               for r, means in zip(v.prediction, member_means(v.prediction_detail), strict=True))
                   + f"; {stalled} stalled runs.")
         return Outcome(rows=v.rows, answer=answer, failed=v.failed, detail=v)
+
+    def file_names(self) -> tuple[str, ...]:
+        return ("validation.csv", "prediction.csv", "validation.md", "prediction_members.csv", "validation.png",
+                "prediction.png", "pulses.png", "seeds.csv", "seeds.png", "effects.csv", "effects.png", "misses.csv")
 
     def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
         """``validation.csv``, ``prediction.csv``, ``validation.md``, ``prediction_members.csv``

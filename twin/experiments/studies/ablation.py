@@ -17,7 +17,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from twin.batch.tables import write_csv
+from twin.batch.tables import counted, write_csv
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.calibrate import CHECK_SEEDS, EXPERIMENT_CELLS, Evaluator, cell_rows
@@ -111,15 +111,21 @@ class AblationExperiment(Experiment):
         parser.add_argument("--workers", type=arguments.workers, default=2, help="processes (default 2)")
 
     def check(self, args: argparse.Namespace) -> None:
+        from twin.experiments.whatifs.common import refuse_oversized
+
         calibrated_values()  # no committed preset: a one-line error before anything is written
+        refuse_oversized(len(variants()) * len(EXPERIMENT_CELLS) * args.seeds, "--seeds")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
-        print(f"{len(variants())} variants x 11 cells x {args.seeds} seeds on the as-built plant -> "
+        print(f"{len(variants())} variants x {len(EXPERIMENT_CELLS)} cells x {counted(args.seeds, 'seed')} on the as-built plant -> "
               f"{out.resolve()}", file=sys.stderr)
         study = ablation_study(seeds=range(args.seeds), workers=args.workers,
                                progress=lambda done, total, label: print(f"[{done}/{total}] {label}", file=sys.stderr))
         return Outcome(rows=study.rows, answer=format_ablation(study),
                        failed=sum(bool(r["failed_runs"]) for r in study.rows), detail=study)
+
+    def file_names(self) -> tuple[str, ...]:
+        return ("ablation.csv", "ablation.png")
 
     def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
         path = out / "ablation.csv"

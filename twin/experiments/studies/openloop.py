@@ -231,6 +231,9 @@ class OpenLoopExperiment(Experiment):
         return Outcome(rows=study.rows, answer=study.answer, failed=sum(bool(run.warnings) for run in study.runs),
                        detail=study)
 
+    def file_names(self) -> tuple[str, ...]:
+        return ("openloop.csv", "openloop.png")
+
     def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
         return [write_openloop(outcome.detail, out)]
 

@@ -22,7 +22,7 @@ from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from twin.batch.grid import GridPoint, expand
 from twin.batch.sweep import run_sweep
-from twin.batch.tables import summarise, write_csv
+from twin.batch.tables import signed, summarise, write_csv
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import THESIS_PAYLOADS_G
@@ -154,7 +154,7 @@ def write_robustness(study: RobustnessStudy, out: pathlib.Path) -> list[pathlib.
 def _cell(row: dict, column: str) -> str:
     if row["status"] != "ok":
         return "failed"
-    return "-" if row[column] is None else f"{row[column]:+.2f}" if column == "sse_deg" else f"{row[column]:.2f}"
+    return "-" if row[column] is None else signed(row[column]) if column == "sse_deg" else f"{row[column]:.2f}"
 
 
 def _per_run_table(study: RobustnessStudy, trajectory: int, column: str, title: str, tail: Sequence[str],
@@ -280,6 +280,9 @@ class RobustnessStudyExperiment(Experiment):
             study = robustness_study(out=out, plant_name=args.plant, seeds=args.seeds, workers=args.workers,
                                      progress=bar.update, ensemble=args.ensemble)
         return Outcome(rows=study.summary, answer=format_robustness(study), failed=len(study.failed), detail=study)
+
+    def file_names(self) -> tuple[str, ...]:
+        return ("robustness_runs.csv", "robustness_summary.csv", "robustness.png")
 
     def write(self, outcome: Outcome, out: pathlib.Path) -> list[pathlib.Path]:
         return write_robustness(outcome.detail, out)

@@ -27,7 +27,7 @@ from twin.exceptions import InvalidScenario
 from twin.experiments import calibrate
 from twin.experiments.arguments import seed_count
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import number_list, progress_bar
+from twin.experiments.whatifs.common import number_list, progress_bar, refuse_oversized
 from twin.physics.params import AIR_FRACTION_MAX
 from twin.sim.metrics import spread
 from viz.figures import finish_panels, plt
@@ -66,6 +66,13 @@ def _cell_label(cell: tuple) -> str:
     return f"{cell[0]:g} g {cell[1][0].upper()}"
 
 
+def runs_per_value(seeds: int) -> int:
+    """The runs of one air value: the fit's cells on its seeds, and the T3 cells on ``seeds`` seeds."""
+    from twin.experiments.validate import PREDICTION_CELLS
+
+    return len(calibrate.CELLS) * len(calibrate.FIT_SEEDS) + len(PREDICTION_CELLS) * seeds
+
+
 def air_study(*, air_pct: Sequence[float], seeds: int = 5, workers: int = 2, bar=None) -> Outcome:
     """The committed preset with the air at each of ``air_pct`` (and at its own value): the fit's cost on
     its seeds and the T3 cells over seeds 0..``seeds``-1 (see the module docstring)."""
@@ -78,7 +85,7 @@ def air_study(*, air_pct: Sequence[float], seeds: int = 5, workers: int = 2, bar
     points = {x / 100: x for x in air_pct}  # fraction -> % as given
     points.setdefault(committed["air_fraction"], committed["air_fraction"] * 100)
     t3_seeds = tuple(range(seeds))
-    per_value = len(calibrate.CELLS) * len(calibrate.FIT_SEEDS) + len(PREDICTION_CELLS) * seeds
+    per_value = runs_per_value(seeds)
     if bar is not None:
         bar.reset(total=len(points) * per_value)
     rows, failed = [], 0
@@ -229,6 +236,7 @@ class AirWhatIf(Experiment):
 
         args.air_values = parse_air(args.air)
         calibration_cost_line()  # a calibration file with a cost and its noise, before anything is written
+        refuse_oversized((len(args.air_values) + 1) * runs_per_value(args.seeds), "--air x --seeds")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import sys
+from collections.abc import Callable, Sequence
 
 from twin.batch import grid
 from twin.exceptions import InvalidScenario
@@ -30,11 +31,12 @@ def list_flag(args: argparse.Namespace, flag: str, attribute: str, axis: str) ->
     return values
 
 
-def refuse_oversized(runs: int, what: str) -> None:
+def refuse_oversized(runs: int, what: str, *, at_most: bool = False) -> None:
     """A what-if of more than :data:`twin.batch.grid.MAX_POINTS` runs, the most a sweep takes, refused before
     anything is built or written, naming ``what`` sets its size ("--periods x --seeds")."""
     if runs > grid.MAX_POINTS:
-        raise InvalidScenario(f"{what} would make {runs:,} runs: more than the {grid.MAX_POINTS:,} a what-if takes")
+        raise InvalidScenario(f"{what} would make {'up to ' if at_most else ''}{runs:,} runs: more than the "
+                              f"{grid.MAX_POINTS:,} one command takes")
 
 
 def number_list(text: str, flag: str, what: str, convert=float) -> list:
@@ -48,6 +50,25 @@ def number_list(text: str, flag: str, what: str, convert=float) -> list:
         return sorted({convert(part) for part in parts})
     except ValueError:
         raise InvalidScenario(f"{flag}: {what} separated by commas, got {text!r}") from None
+
+
+BATCH_RUNS = 200  # runs a what-if simulates at once: a run keeps its whole trace (about 1.2 MB on T1-T3) until
+# its batch ends, so a batch of all of a large what-if's runs ran out of memory (99,000 took 20 GB, 2026-11-27)
+
+
+def simulate_in_parts(scenarios: Sequence, controllers: Sequence, keep: Callable, bar=None) -> list:
+    """``keep(result)`` of each scenario's run, in order, simulated :data:`BATCH_RUNS` at a time so that memory
+    holds one part's traces, not all; ``bar`` (tqdm, or None) counts the runs. Each run is its own, so the
+    numbers are those of one batch (tested)."""
+    from twin.sim.simulation import simulate
+
+    kept: list = []
+    for start in range(0, len(scenarios), BATCH_RUNS):
+        part = slice(start, start + BATCH_RUNS)
+        results = simulate(scenarios[part], controllers=controllers[part],
+                           progress=batch_progress(bar, len(scenarios[part])))
+        kept += [keep(r) for r in results]
+    return kept
 
 
 def batch_progress(bar, count: int):

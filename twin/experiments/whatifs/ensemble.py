@@ -93,10 +93,20 @@ def member_count() -> int:
 
 
 def _run_member(batch: Callable, member: int, cases: tuple, seeds: tuple) -> tuple[int, dict]:
-    """``batch(plant, cases, seeds)`` on ensemble member ``member``: {(case, seed): Run}."""
+    """``batch(plant, cases, seeds)`` on ensemble member ``member``: {(case, seed): Run}; called on parts of at
+    most :data:`BATCH_RUNS` (case, seed) pairs, so that memory holds one part's traces (each run is its own:
+    the same numbers as one call)."""
+    from twin.experiments.whatifs.common import BATCH_RUNS
     from twin.plants import ENSEMBLE_PREFIX, plant
 
-    return member, batch(plant(f"{ENSEMBLE_PREFIX}{member}"), cases, seeds)
+    member_plant = plant(f"{ENSEMBLE_PREFIX}{member}")
+    seed_part = min(len(seeds), BATCH_RUNS) or 1
+    case_part = max(1, BATCH_RUNS // seed_part)
+    out: dict = {}
+    for c in range(0, len(cases), case_part):
+        for s in range(0, len(seeds), seed_part):
+            out.update(batch(member_plant, cases[c:c + case_part], seeds[s:s + seed_part]))
+    return member, out
 
 
 def over_ensemble(batch: Callable, cases: Sequence, *, seeds: Sequence[int], workers: int = 2,

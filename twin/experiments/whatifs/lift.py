@@ -15,10 +15,10 @@ from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import THESIS_PAYLOADS_G
 from twin.experiments.whatifs.common import (
     add_common_arguments,
-    batch_progress,
     list_flag,
     progress_bar,
     refuse_oversized,
+    simulate_in_parts,
 )
 from twin.physics import friction
 from twin.physics.model import Orientation
@@ -53,17 +53,17 @@ def lift_limit_closed_form(params: JointParams, supply_pressure: float) -> float
     return float(np.min(mass))
 
 
-def _lifts(payloads: np.ndarray, pressures: np.ndarray, plant_name: str, progress=None) -> np.ndarray:
-    """Simulate each (payload, pressure) from 80 deg (T3's start) with the valves fully open, one batch
-    (``progress`` as for ``simulate``); True where the link passes the end of LIFT_SPAN_DEG within the run."""
+def _lifts(payloads: np.ndarray, pressures: np.ndarray, plant_name: str, bar=None) -> np.ndarray:
+    """Simulate each (payload, pressure) from 80 deg (T3's start) with the valves fully open (``bar`` counts
+    the runs); True where the link passes the end of LIFT_SPAN_DEG within the run."""
     from controllers.open_loop import OpenLoop
-    from twin.sim.simulation import simulate
 
     scenarios = [Scenario(None, 3, payload=float(m), orientation=Orientation.VERTICAL, plant=plant_name,
                           noise=False, supply_pressure=float(p)) for m, p in zip(payloads, pressures, strict=True)]
     opener = OpenLoop(schedule=lambda t: 100.0, tick=plant(plant_name).timestep)
-    results = simulate(scenarios, controllers=[opener] * len(scenarios), progress=progress)
-    return np.array([np.degrees(r.trace.angle).max() >= LIFT_SPAN_DEG[1] for r in results])
+    return np.array(simulate_in_parts(scenarios, [opener] * len(scenarios),
+                                      lambda r: bool(np.degrees(r.trace.angle).max() >= LIFT_SPAN_DEG[1]), bar),
+                    dtype=bool)
 
 
 def _lift_at(pressure: float, pressures: np.ndarray, lifted_g: np.ndarray) -> str:
@@ -113,7 +113,7 @@ def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", to
         bar.reset(total=planned_runs(pressures_kpa, plant_name, tolerance))
 
     def lifts(payloads: np.ndarray, at: np.ndarray) -> np.ndarray:
-        return _lifts(payloads, at, plant_name, progress=batch_progress(bar, len(at)))
+        return _lifts(payloads, at, plant_name, bar)
 
     first = lifts(np.concatenate([np.zeros(n), np.full(n, THESIS_PAYLOAD)]), np.concatenate([pressures, pressures]))
     bare_link_lifts, payload_lifts = first[:n], first[n:]  # the payload itself, not read off the bisection

@@ -52,7 +52,7 @@ from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.reference import ROBUSTNESS_CELLS
-from twin.experiments.whatifs.common import progress_bar
+from twin.experiments.whatifs.common import progress_bar, refuse_oversized
 from viz.figures import finish_panels, plt
 
 COLUMNS = ("experiment", "cell", "band_width_before_deg", "band_width_after_deg", "rig_hours")
@@ -267,11 +267,11 @@ def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_
             f"(widest cell {cell_label(ROBUSTNESS_CELLS[widest])}: {before[widest]:.2f} -> "
             f"{after[widest]:.2f} deg); rig time {hours[name]:.1f} h; narrowing {score[name]:.2f} per hour.")
     best = max(score, key=score.get)
-    if score[best] > 0:
+    if round(score[best], 2) > 0:  # as the lines above print it: 0.00 per hour narrows nothing worth saying
         lines.append(f"Answer: run the {best} experiment next: it narrows the predictions most per hour of rig time.")
     else:
-        lines.append("Answer: none of these experiments narrows the predictions here (each keeps its bands' whole "
-                     "width), so none is worth its rig time by this measure; more members or seeds may tell them apart.")
+        lines.append("Answer: none of these experiments narrows the predictions here by 0.01 per hour of rig time or "
+                     "more, so none is worth its rig time by this measure; more members or seeds may tell them apart.")
     lines.append(f"Assumed: supply steps of {pressure_step / 1e3:g} kPa from {LADDER_START / 1e3:g} kPa (the "
                  f"air-over-water supply set by its air regulator; not finer), {len(MAP_ANGLES_DEG)} rest positions "
                  f"20-160 deg ({LOADED_PAYLOAD * 1e3:g} g on the link, vertical, for the loaded map), "
@@ -322,6 +322,11 @@ class NextExperimentWhatIf(Experiment):
             raise InvalidScenario("--seeds: the spread within a member needs at least 2 seeds")
         if not (math.isfinite(args.pressure_step) and 1.0 <= args.pressure_step <= 100.0):
             raise InvalidScenario(f"--pressure-step: 1-100 kPa, got {args.pressure_step:g}")
+        members = ensemble.member_count() if args.members is None else args.members
+        rounds = math.ceil(math.log2(len(ladder(args.pressure_step * 1e3)) + 1))  # a map's bisection, at most
+        per_seed = len(MAPS) * len(MAP_ANGLES_DEG) * rounds + 1  # the two maps' positions each round, the sine
+        refuse_oversized(members * (args.seeds * per_seed + args.prediction_seeds * len(ROBUSTNESS_CELLS)),
+                         "--seeds x --prediction-seeds x --members", at_most=True)
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

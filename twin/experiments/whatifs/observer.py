@@ -20,6 +20,7 @@ from collections.abc import Sequence
 import numpy as np
 
 import twin.experiments.whatifs.ensemble as ensemble
+from twin.batch.tables import counted
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import progress_bar, refuse_oversized
 from twin.physics.params import OBSERVER_KINDS
@@ -76,7 +77,7 @@ def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
     from twin.physics.params import NOMINAL_PARAMS
 
     found = _by_case(rows)
-    lines = [f"As-built plant, {members} calibration ensemble members x {seeds} seeds; errors against the twin's "
+    lines = [f"As-built plant, {counted(members, 'calibration ensemble member')} x {counted(seeds, 'seed')}; errors against the twin's "
              "true rack state (committed preset), RMSE in deg as committed preset (ensemble 10-90 %). The Kalman "
              "filter runs on the thesis's bore and viscous friction and the train's mass referred to the rack "
              f"({referred_mass() * 1e3:.1f} g, not the thesis's lumped {NOMINAL_PARAMS.masses.thesis_total_mass * 1e3:.1f} "

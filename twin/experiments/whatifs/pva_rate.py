@@ -19,6 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 import twin.experiments.whatifs.ensemble as ensemble
+from twin.batch.tables import counted, signed
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import number_list, progress_bar, refuse_oversized
@@ -95,7 +96,7 @@ def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
     row = _by_case(rows)
     cells = sorted({(r["trajectory"], r["payload_g"], r["orientation"]) for r in rows},
                    key=lambda c: (c[2], c[1], c[0]))
-    lines = [f"As-built plant, {members} calibration ensemble members x {seeds} seeds per case; RMSE in deg as "
+    lines = [f"As-built plant, {counted(members, 'calibration ensemble member')} x {counted(seeds, 'seed')} per case; RMSE in deg as "
              f"committed preset (ensemble 10-90 %). FF + PVA (and sliding mode's FF + PVA part) updated every "
              f"{', '.join(f'{r:g}' for r in rates)} ms; the valves keep the 16 ms PWM."]
     for controller in ("ffpva", "smc"):
@@ -103,7 +104,7 @@ def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
                   - row[controller, c, fast]["rmse_mean_deg"]) for c in cells]
         better = sum(g > 0 for g in gains)
         lines.append(f"{CONTROLLER_LABELS[controller]}: at {fast:g} ms instead of 16 ms, RMSE is lower in "
-                     f"{better} of {len(cells)} cells (median change {-np.median(gains):+.2f} deg).")
+                     f"{better} of {len(cells)} cells (median change {signed(-np.median(gains))} deg).")
     best_ffpva = {c: min((row["ffpva", c, ms] for ms in rates), key=lambda r: r["rmse_mean_deg"])
                   for c in cells}
     smc_thesis = {c: row["smc", c, THESIS_UPDATE_MS] for c in cells}
@@ -128,8 +129,8 @@ def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
                else "no, as far as the twin shows: in most cells it does not")
     lines.append(f"In short: {verdict} the faster FF + PVA does at least as well as the thesis's sliding mode. "
                  f"Against FF + PVA at 16 ms, FF + PVA at its best rate (the lowest of the rates run, picked on "
-                 f"these same runs, so an optimistic pick) changes RMSE by a median {-faster:+.2f} deg, sliding "
-                 f"mode at 16 ms by {-sliding:+.2f} deg. A caveat that weighs on this answer: in the twin, "
+                 f"these same runs, so an optimistic pick) changes RMSE by a median {signed(-faster)} deg, sliding "
+                 f"mode at 16 ms by {signed(-sliding)} deg. A caveat that weighs on this answer: in the twin, "
                  f"FF + PVA at 16 ms already matches or beats sliding mode in {len(already)} of {len(cells)} cells, "
                  "the reverse of the thesis's experiments (docs/as-built.md: at the thesis's phi the switching term "
                  "is a few % of duty, and it is all that lifts the twin's sliding mode out of the valve's 26 % dead "

@@ -13,10 +13,10 @@ from twin.batch.tables import summarise
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import (
     add_common_arguments,
-    batch_progress,
     list_flag,
     progress_bar,
     refuse_oversized,
+    simulate_in_parts,
 )
 from twin.physics.valves import ValveModel
 from twin.plants import Plant, plant
@@ -53,7 +53,6 @@ def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = TRAJ
     (a tqdm bar, optional) is given the number of scenarios before they run, then counts them."""
     from controllers import make_controller
     from twin.envs.runner import nominal_model
-    from twin.sim.simulation import simulate
 
     base = plant(plant_name)
     cases = [(Scenario(c, t, plant=plant_name, seed=s, pwm_period=ms / 1e3), ms)
@@ -62,10 +61,10 @@ def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = TRAJ
                    for c in MODEL_BASED_CONTROLLERS}
     if bar is not None:
         bar.reset(total=len(cases))
-    results = simulate([s for s, _ in cases], controllers=[controllers[s.controller] for s, _ in cases],
-                       progress=batch_progress(bar, len(cases)))
-    records = [{**report.summary(r), "pwm_period_ms": ms, "status": "failed" if r.warnings else "ok"}
-               for r, (_, ms) in zip(results, cases, strict=True)]
+    kept = simulate_in_parts([s for s, _ in cases], [controllers[s.controller] for s, _ in cases],
+                             lambda r: (report.summary(r), bool(r.warnings)), bar)
+    records = [{**summary, "pwm_period_ms": ms, "status": "failed" if failed else "ok"}
+               for (summary, failed), (_, ms) in zip(kept, cases, strict=True)]
     rows = summarise(records)
     lines = [_pwm_setup(base)]
     for controller in MODEL_BASED_CONTROLLERS:
@@ -73,9 +72,9 @@ def pwm_study(*, periods_ms: Sequence[float], trajectories: Sequence[int] = TRAJ
             group = sorted((r for r in rows if r["controller"] == controller and r["trajectory"] == t),
                            key=lambda r: r["pwm_period_ms"])
             best = min(group, key=lambda r: r["rmse_mean_deg"])
-            alike = len({r["rmse_mean_deg"] for r in group}) == 1
+            alike = len({f"{r['rmse_mean_deg']:.2f}" for r in group}) == 1  # as the answer prints them
             lines.append(f"{controller} T{t}: "
-                         + (f"the same at every period ({best['rmse_mean_deg']:.2f} deg); " if alike else
+                         + (f"the same at every period to 0.01 deg ({best['rmse_mean_deg']:.2f}); " if alike else
                             f"best {best['pwm_period_ms']:g} ms ({best['rmse_mean_deg']:.2f} deg); ")
                          + ", ".join(f"{r['pwm_period_ms']:g} ms {r['rmse_mean_deg']:.2f}" for r in group))
     return Outcome(rows, "\n".join(lines))

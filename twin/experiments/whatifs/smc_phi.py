@@ -23,10 +23,10 @@ from twin.experiments.base import Experiment, Outcome
 from twin.experiments.validate import RMSE_TOLERANCE
 from twin.experiments.whatifs.common import (
     add_common_arguments,
-    batch_progress,
     number_list,
     progress_bar,
     refuse_oversized,
+    simulate_in_parts,
 )
 from twin.sim.metrics import spread
 from viz.figures import finish_panels, plt
@@ -52,6 +52,15 @@ def parse_phis(text: str) -> tuple[float, ...]:
     return tuple(values)  # number_list sorts them
 
 
+def plant_phi(base) -> float:
+    """The boundary layer of ``base``'s own sliding mode (its gain set's), m/s: always run beside the given ones."""
+    import controllers
+    from twin.envs.runner import nominal_model
+
+    return controllers.make_controller("smc", nominal=nominal_model(base), gain_set=base.gain_set,
+                                       tick=base.timestep).gains.boundary_layer
+
+
 def _label(row: dict) -> str:
     orientation = "" if row["orientation"] == "horizontal" and not row["payload_g"] else (
         f" {row['payload_g']:g} g {row['orientation'][0].upper()}")
@@ -68,12 +77,11 @@ def phi_study(*, phis: Sequence[float], seeds: int = 10, plant_name: str = "as-b
     from twin.experiments.whatifs.ensemble import cell_scenario
     from twin.physics.valves import ValveModel
     from twin.plants import plant
-    from twin.sim.simulation import simulate
 
     base = plant(plant_name)
     nominal = nominal_model(base)
     thesis = controllers.make_controller("smc", nominal=nominal, gain_set=base.gain_set, tick=base.timestep)
-    phis = tuple(sorted(set(phis) | {thesis.gains.boundary_layer}))
+    phis = tuple(sorted(set(phis) | {plant_phi(base)}))
     laws = {("smc", phi): dataclasses.replace(thesis, gains=dataclasses.replace(thesis.gains, boundary_layer=phi))
             for phi in phis}
     laws[("ffpva", None)] = controllers.make_controller("ffpva", nominal=nominal, gain_set=base.gain_set,
@@ -82,13 +90,14 @@ def phi_study(*, phis: Sequence[float], seeds: int = 10, plant_name: str = "as-b
     jobs = [(key, cell, s) for key in laws for cell in cells for s in range(seeds)]
     if bar is not None:
         bar.reset(total=len(jobs))
-    results = simulate([cell_scenario((key[0], *cell), base, s) for key, cell, s in jobs],
-                       controllers=[laws[key] for key, _, _ in jobs], progress=batch_progress(bar, len(jobs)))
+    results = simulate_in_parts([cell_scenario((key[0], *cell), base, s) for key, cell, s in jobs],
+                                [laws[key] for key, _, _ in jobs],
+                                lambda r: (r.metrics.rmse, bool(r.warnings)), bar)
     lags = (validate.ramp_opening_lags(base, nominal, laws)["lag_deg"]
             if base.valve_model is ValveModel.SOLENOID else {})  # no valve threshold to reach: no closed form
     rmse: dict[tuple, list[float]] = {}  # (law key, cell) -> the runs' RMSE, deg
-    for (key, cell, _), r in zip(jobs, results, strict=True):
-        rmse.setdefault((key, cell), []).append(math.degrees(r.metrics.rmse))
+    for (key, cell, _), (run_rmse, _) in zip(jobs, results, strict=True):
+        rmse.setdefault((key, cell), []).append(math.degrees(run_rmse))
     rows = []
     for key in laws:
         for cell in cells:
@@ -96,7 +105,7 @@ def phi_study(*, phis: Sequence[float], seeds: int = 10, plant_name: str = "as-b
             target = TARGET_OF[(key[0], *cell)]
             rows.append(dict(zip(COLUMNS, (key[0], key[1], target.source, *cell, s.mean, s.std, target.rmse_deg,
                                            s.mean / target.rmse_deg, lags.get(key, math.nan)), strict=True)))
-    failed = sum(bool(r.warnings) for r in results)
+    failed = sum(warned for _, warned in results)
     return Outcome(rows, answer(rows, phi=thesis.gains.boundary_layer, seeds=seeds, plant_name=plant_name),
                    failed=failed, detail=thesis.gains.boundary_layer)
 
@@ -188,7 +197,7 @@ class SmcPhiWhatIf(Experiment):
         from twin.plants import plant
 
         args.phi_values = parse_phis(args.phis)
-        laws = len(args.phi_values) + 2  # at most: the plant's own phi is added if not given, and FF + PVA
+        laws = len(set(args.phi_values) | {plant_phi(plant(args.plant))}) + 1  # the plant's own phi, and FF + PVA
         refuse_oversized(laws * len(measured_cells()) * args.seeds, "--phis x --seeds")
         if plant(args.plant).gain_set != "experiment":
             raise InvalidScenario(f"--plant {args.plant} runs the thesis's simulation gains; smc-phi compares with the "

@@ -12,7 +12,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from twin.batch.tables import summarise
+from twin.batch.tables import counted, signed, summarise
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
@@ -54,14 +54,14 @@ def supply_study(*, trajectories: Sequence[int] = (1, 3), seeds: int = 3, plant_
     line = variants["line"].params.supply_line
     lines = [f"{plant_name} plant, supply through a hose ringing at {line.natural_frequency:g} Hz (line), the same with "
              f"a {line.accumulator_compliance:.0e} m^3/Pa gas accumulator at the valve block (accumulator), and a "
-             f"constant {NOMINAL_PARAMS.supply.pressure / 1e3:g} kPa (constant); mean RMSE over {seeds} seeds:"]
+             f"constant {NOMINAL_PARAMS.supply.pressure / 1e3:g} kPa (constant); mean RMSE over {counted(seeds, 'seed')}:"]
     for controller in MODEL_BASED_CONTROLLERS:
         for t in trajectories:
             by_model = {r["supply_model"]: r for r in rows if r["controller"] == controller and r["trajectory"] == t}
             line_rmse = by_model["line"]["rmse_mean_deg"]
             lines.append(f"{controller} T{t}: " + ", ".join(
                 f"{m} {by_model[m]['rmse_mean_deg']:.2f} deg ({by_model[m]['rmse_mean_deg'] / line_rmse - 1:+.0%}"
-                + ("" if np.isnan(by_model[m]["sse_mean_deg"]) else f", SSE {by_model[m]['sse_mean_deg']:+.2f}")
+                + ("" if np.isnan(by_model[m]["sse_mean_deg"]) else f", SSE {signed(by_model[m]['sse_mean_deg'])}")
                 + ")" for m in SUPPLY_MODELS))
     return Outcome(rows, "\n".join(lines))
 
