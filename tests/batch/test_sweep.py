@@ -63,12 +63,15 @@ def test_a_range_over_the_cap_is_refused_with_its_size_before_any_value_is_made(
     assert len(grid.parse_axis("payload", "1:100000:1")) == 100_000  # the cap itself is allowed
 
 
-@pytest.mark.parametrize("name, value", [("payload", ",".join(["0:99999:1"] * 3)), ("seed", "0-60000,70000-130000")])
+@pytest.mark.parametrize("name, value", [("payload", ",".join(["0:99999:1", "100000:150000:1"] * 3)),
+                                         ("seed", "0-60000,70000-130000")])
 def test_many_ranges_each_under_the_cap_are_refused_together(name, value):
     """Each range was checked alone, the total only once the grid was expanded: thirty ranges of 100,000 values
     took 356 MB before the refusal (found by review, 2026-11-27)."""
     with pytest.raises(InvalidScenario, match=f"--{name} has more than the 100,000 values a sweep takes"):
         grid.parse_axis(name, value)
+    # values given twice count once: 100,000 distinct seeds are allowed however they are written
+    assert len(grid.parse_axis("seed", "0-99999,0")) == len(grid.parse_axis("seed", "0-60000,50000-99999")) == 100_000
 
 
 @pytest.mark.parametrize("name, value", [("seed", "0,0"), ("payload", "0,0.0"), ("payload", "-0,0"),
@@ -190,6 +193,23 @@ def test_an_sqlite_file_of_something_else_is_refused_unwritten(tmp_path, table, 
     with pytest.raises(StaleStore, match=f"is not a results store of this twin \\(it holds a table '{table}' that"):
         ResultStore(path, version="a")
     assert path.read_bytes() == before and sorted(p.name for p in tmp_path.iterdir()) == ["results.sqlite"]
+
+
+def test_a_store_a_database_tool_analysed_is_still_this_twins(tmp_path):
+    """ANALYZE (or PRAGMA optimize) in a database tool adds SQLite's own sqlite_stat1: not a table of another
+    program; a table name that needs quoting is read, not a syntax error."""
+    path = tmp_path / "results.sqlite"
+    ResultStore(path, version="a").close()
+    with sqlite3.connect(path) as db:
+        db.execute("ANALYZE")
+        assert db.execute("SELECT COUNT(*) FROM sqlite_master WHERE name = 'sqlite_stat1'").fetchone() == (1,)
+    db.close()
+    ResultStore(path, version="a").close()
+    with sqlite3.connect(path) as db:
+        db.execute('CREATE TABLE "it\'s ""x""" (a)')
+    db.close()
+    with pytest.raises(StaleStore, match="is not a results store of this twin"):
+        ResultStore(path, version="a")
 
 
 def test_a_store_without_a_version_but_with_results_is_refused(tmp_path):

@@ -838,7 +838,7 @@ def test_ray_failing_to_connect_is_not_read_as_a_file_that_cannot_be_written(mon
     monkeypatch.setattr(ray, "is_initialized", lambda: False)
     monkeypatch.setattr(ray, "init", refuse)
     with pytest.raises(sweep.ClusterUnreachable, match="^lost or could not reach the Ray cluster at auto: Could not "
-                                                       "find any running Ray instance.$"):
+                                                       "find any running Ray instance.; finished scenarios are kept"):
         sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)
     monkeypatch.setattr(ray, "is_initialized", lambda: True)  # connected; then the connection breaks mid-sweep
     monkeypatch.setattr(ray, "cluster_resources", lambda: {"CPU": 1})
@@ -847,6 +847,25 @@ def test_ray_failing_to_connect_is_not_read_as_a_file_that_cannot_be_written(mon
     monkeypatch.setattr(ray, "cancel", lambda ref: None)
     with pytest.raises(sweep.ClusterUnreachable, match="^lost or could not reach the Ray cluster at auto"):
         sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)
+
+
+def test_a_broken_pipe_while_a_ray_sweep_reports_is_not_the_clusters(monkeypatch):
+    """Only Ray's own calls are read as the cluster's: on_done's own BrokenPipeError (a ConnectionError) is not."""
+    import ray
+
+    from twin.batch import grid, sweep
+
+    def broken(rows):
+        raise BrokenPipeError(errno.EPIPE, "Broken pipe")
+
+    monkeypatch.setattr(ray, "is_initialized", lambda: True)
+    monkeypatch.setattr(ray, "cluster_resources", lambda: {"CPU": 1})
+    monkeypatch.setattr(ray, "remote", lambda function: type("Remote", (), {"remote": lambda self, chunk: chunk})())
+    monkeypatch.setattr(ray, "wait", lambda pending, num_returns: (pending[:1], pending[1:]))
+    monkeypatch.setattr(ray, "get", lambda ref: [])
+    monkeypatch.setattr(ray, "cancel", lambda ref: None)
+    with pytest.raises(BrokenPipeError):
+        sweep._ray(grid.expand({"seed": [0]}), None, "auto", broken)
 
 
 def test_an_os_error_without_a_file_is_said_as_itself(capsys, monkeypatch):

@@ -361,17 +361,28 @@ def test_whatif_air_scores_as_the_fit_does_and_moves_the_air_alone(tmp_path):
     assert "A what-if, not a fit" in (tmp_path / "air" / "air.txt").read_text()
 
 
-@pytest.mark.slow  # about 6 s: four small batches
-def test_a_what_if_simulated_in_parts_gives_the_numbers_of_one_batch(monkeypatch):
-    """Since 2026-11-27 the what-ifs simulate at most BATCH_RUNS runs at once (one batch of all of them ran out of
-    memory); each run is its own, so parts of 3 (or of 1 pair per ensemble batch) give the one batch's numbers."""
-    from twin.experiments.whatifs import common, ensemble
+@pytest.mark.slow  # about 10 s: small batches, each twice
+def test_runs_simulated_in_parts_give_the_numbers_of_one_batch(monkeypatch):
+    """Since 2026-11-27 the what-ifs, the ensemble's batches, the calibration's evaluator (so air and ablation) and
+    the supply what-if simulate at most RUN_PART runs at once (one batch of all of them ran out of memory); each
+    run is its own, so parts of 3 (or of 1 pair per ensemble batch) give the one batch's numbers."""
+    from twin.experiments import calibrate
+    from twin.experiments.whatifs import ensemble
     from twin.experiments.whatifs.pwm import pwm_study
+    from twin.experiments.whatifs.supply import supply_study
+    from twin.plants.as_built import calibrated_values
+    from twin.sim import simulation
 
-    whole = pwm_study(periods_ms=[8.0, 16.0], seeds=1, plant_name="thesis-pwm").rows
-    cases, seeds = ensemble.study_cells()[:2], (0, 1)
-    together = ensemble.over_ensemble(ensemble.cells_batch, cases, seeds=seeds, workers=1, members=1)
-    monkeypatch.setattr(common, "BATCH_RUNS", 3)
-    assert repr(pwm_study(periods_ms=[8.0, 16.0], seeds=1, plant_name="thesis-pwm").rows) == repr(whole)  # nan too
-    monkeypatch.setattr(common, "BATCH_RUNS", 1)
-    assert repr(ensemble.over_ensemble(ensemble.cells_batch, cases, seeds=seeds, workers=1, members=1)) == repr(together)
+    def everything() -> str:  # repr: a nan equals itself there
+        cases = ensemble.study_cells()[:2]
+        with calibrate.Evaluator(seeds=(0, 1), workers=1, cells=calibrate.CELLS[:3]) as evaluator:
+            cells = [(c.key, c.rmse_deg, c.sse_deg) for c in evaluator.cells(calibrated_values())]
+        return repr((pwm_study(periods_ms=[8.0, 16.0], seeds=1, plant_name="thesis-pwm").rows,
+                     ensemble.over_ensemble(ensemble.cells_batch, cases, seeds=(0, 1), workers=1, members=1),
+                     cells, supply_study(trajectories=(1,), seeds=1).rows))
+
+    whole = everything()
+    monkeypatch.setattr(simulation, "RUN_PART", 3)
+    assert everything() == whole
+    monkeypatch.setattr(simulation, "RUN_PART", 1)
+    assert everything() == whole

@@ -88,8 +88,10 @@ def parse_axis(name: str, value) -> list:
                 out += list(range(low, high + 1))
             else:
                 out.append(kind(text) if kind is str else _number(text, kind))
-            if len(out) > MAX_POINTS:  # many ranges, each under the cap: refused before the next is made
-                raise InvalidScenario(f"{flag} has more than the {MAX_POINTS:,} values a sweep takes")
+            if len(out) > MAX_POINTS:  # many ranges, each under the cap: their distinct values refused together
+                out = list(dict.fromkeys(out))
+                if len(out) > MAX_POINTS:
+                    raise InvalidScenario(f"{flag} has more than the {MAX_POINTS:,} values a sweep takes")
         except InvalidScenario:
             raise
         except ValueError:

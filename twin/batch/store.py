@@ -53,8 +53,9 @@ class ResultStore:
         """The first table the file holds that this store would not make (another name, or ``results`` or
         ``meta`` with other columns): an SQLite file of something else, found before anything is written."""
         expected = {"results": list(COLUMNS), "meta": ["name", "value"]}
-        for (table,) in self._db.execute("SELECT name FROM sqlite_master WHERE type = 'table' ORDER BY name"):
-            found = [row[1] for row in self._db.execute(f"PRAGMA table_info({table!r})")]
+        for (table,) in self._db.execute("SELECT name FROM sqlite_master WHERE type = 'table' AND name NOT LIKE "
+                                         "'sqlite!_%' ESCAPE '!' ORDER BY name"):  # not SQLite's own (ANALYZE's)
+            found = [row[0] for row in self._db.execute("SELECT name FROM pragma_table_info(?)", (table,))]
             if found != expected.get(table):
                 return table
         return None

@@ -212,26 +212,28 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
     import ray
 
     where = address or os.environ.get("RAY_ADDRESS") or None
-    try:
-        _ray_tasks(ray, points, workers, where, on_done)
-    except ConnectionError as error:  # an OSError, which would read as a file that cannot be written
-        raise ClusterUnreachable(f"lost or could not reach the Ray cluster at {where or 'a local Ray'}: "
-                                 f"{str(error).splitlines()[0]}") from None
 
+    def cluster(call, *args, **kwargs):
+        """A call to Ray; its ConnectionError (an OSError, which would read as a file that cannot be written)
+        said as the cluster's. Only Ray's calls: a broken pipe in ``on_done`` is not the cluster's."""
+        try:
+            return call(*args, **kwargs)
+        except ConnectionError as error:
+            raise ClusterUnreachable(f"lost or could not reach the Ray cluster at {where or 'a local Ray'}: "
+                                     f"{str(error).splitlines()[0]}; finished scenarios are kept, run the same "
+                                     "command again to finish the rest") from None
 
-def _ray_tasks(ray, points: Sequence[GridPoint], workers: int | None, where: str | None,
-               on_done: Callable[[list[dict]], None]) -> None:
     started_here = not ray.is_initialized()
     if started_here:  # log_to_driver=False: worker prints would flood the progress bar
-        ray.init(address=where, include_dashboard=False, log_to_driver=False)
+        cluster(ray.init, address=where, include_dashboard=False, log_to_driver=False)
     pending = []
     try:
-        cpus = workers or int(ray.cluster_resources().get("CPU", 1))
+        cpus = workers or int(cluster(ray.cluster_resources).get("CPU", 1))
         remote = ray.remote(run_chunk)
-        pending = [remote.remote(chunk) for chunk in make_chunks(points, max(1, cpus))]
+        pending = [cluster(remote.remote, chunk) for chunk in make_chunks(points, max(1, cpus))]
         while pending:
-            done, pending = ray.wait(pending, num_returns=1)
-            on_done(ray.get(done[0]))
+            done, pending = cluster(ray.wait, pending, num_returns=1)
+            on_done(cluster(ray.get, done[0]))
     finally:
         for ref in pending:
             ray.cancel(ref)

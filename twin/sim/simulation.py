@@ -87,6 +87,19 @@ def _warnings(counts: np.ndarray) -> tuple[str, ...]:
     return tuple(f"{mujoco.mjtWarning(index).name} x{count}" for index, count in enumerate(counts) if count)
 
 
+RUN_PART = 200  # runs simulated at once where a command's runs can be many: a run keeps its whole trace (about
+# 1.2 MB on T1-T3) until its batch ends, and one batch of 99,000 ran out of 20 GB (2026-11-27)
+
+
+def in_parts(items: Sequence, work: Callable[[Sequence], list]) -> list:
+    """``work`` on consecutive parts of at most :data:`RUN_PART` of ``items``, its lists joined, so that memory holds
+    one part's runs, not all. Each run is its own (its seed, its state), so the numbers are one batch's (tested)."""
+    out: list = []
+    for start in range(0, len(items), RUN_PART):
+        out += work(items[start:start + RUN_PART])
+    return out
+
+
 def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller],
              progress: Callable[[int, int], None] | None = None, nthread: int = 0,
              start_positions: np.ndarray | None = None) -> list[Result]:

@@ -52,23 +52,18 @@ def number_list(text: str, flag: str, what: str, convert=float) -> list:
         raise InvalidScenario(f"{flag}: {what} separated by commas, got {text!r}") from None
 
 
-BATCH_RUNS = 200  # runs a what-if simulates at once: a run keeps its whole trace (about 1.2 MB on T1-T3) until
-# its batch ends, so a batch of all of a large what-if's runs ran out of memory (99,000 took 20 GB, 2026-11-27)
-
-
 def simulate_in_parts(scenarios: Sequence, controllers: Sequence, keep: Callable, bar=None) -> list:
-    """``keep(result)`` of each scenario's run, in order, simulated :data:`BATCH_RUNS` at a time so that memory
-    holds one part's traces, not all; ``bar`` (tqdm, or None) counts the runs. Each run is its own, so the
-    numbers are those of one batch (tested)."""
-    from twin.sim.simulation import simulate
+    """``keep(result)`` of each scenario's run, in order, simulated in parts
+    (:func:`twin.sim.simulation.in_parts`) so that memory holds one part's traces; ``bar`` (tqdm, or None)
+    counts the runs."""
+    from twin.sim.simulation import in_parts, simulate
 
-    kept: list = []
-    for start in range(0, len(scenarios), BATCH_RUNS):
-        part = slice(start, start + BATCH_RUNS)
-        results = simulate(scenarios[part], controllers=controllers[part],
-                           progress=batch_progress(bar, len(scenarios[part])))
-        kept += [keep(r) for r in results]
-    return kept
+    def work(indices: range) -> list:
+        results = simulate([scenarios[i] for i in indices], controllers=[controllers[i] for i in indices],
+                           progress=batch_progress(bar, len(indices)))
+        return [keep(r) for r in results]
+
+    return in_parts(range(len(scenarios)), work)
 
 
 def batch_progress(bar, count: int):

@@ -94,14 +94,15 @@ def member_count() -> int:
 
 def _run_member(batch: Callable, member: int, cases: tuple, seeds: tuple) -> tuple[int, dict]:
     """``batch(plant, cases, seeds)`` on ensemble member ``member``: {(case, seed): Run}; called on parts of at
-    most :data:`BATCH_RUNS` (case, seed) pairs, so that memory holds one part's traces (each run is its own:
-    the same numbers as one call)."""
-    from twin.experiments.whatifs.common import BATCH_RUNS
+    most :data:`twin.sim.simulation.RUN_PART` (case, seed) pairs, so that memory holds one part's traces (each
+    run is its own: the same numbers as one call). A pair is one run for most batches, more for some (the
+    breakaway maps' 8 rest positions a bisection round)."""
     from twin.plants import ENSEMBLE_PREFIX, plant
+    from twin.sim.simulation import RUN_PART
 
     member_plant = plant(f"{ENSEMBLE_PREFIX}{member}")
-    seed_part = min(len(seeds), BATCH_RUNS) or 1
-    case_part = max(1, BATCH_RUNS // seed_part)
+    seed_part = min(len(seeds), RUN_PART) or 1
+    case_part = max(1, RUN_PART // seed_part)
     out: dict = {}
     for c in range(0, len(cases), case_part):
         for s in range(0, len(seeds), seed_part):

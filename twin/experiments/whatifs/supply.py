@@ -40,15 +40,19 @@ def supply_study(*, trajectories: Sequence[int] = (1, 3), seeds: int = 3, plant_
     """FF + PVA and sliding mode on ``trajectories`` with each supply model, ``seeds`` runs each, one batch;
     ``bar`` (a tqdm bar, optional) is given the number of scenarios before they run, then counts them."""
     from twin.envs.runner import run_many
+    from twin.sim.simulation import in_parts
 
     variants = supply_variants(plant(plant_name))
     cases = [(Scenario(c, t, plant=variants[m], seed=s), m)
              for m in SUPPLY_MODELS for c in MODEL_BASED_CONTROLLERS for t in trajectories for s in range(seeds)]
     if bar is not None:
         bar.reset(total=len(cases))
-    results = run_many([s for s, _ in cases], progress=batch_progress(bar, len(cases)))
-    records = [{**report.summary(r), "pwm_period_ms": None, "status": "failed" if r.warnings else "ok"}
-               for r in results]
+    def work(part: list) -> list[dict]:  # a part's runs, then only their summaries
+        results = run_many([s for s, _ in part], progress=batch_progress(bar, len(part)))
+        return [{**report.summary(r), "pwm_period_ms": None, "status": "failed" if r.warnings else "ok"}
+                for r in results]
+
+    records = in_parts(cases, work)
     model_of = {variant.name: model for model, variant in variants.items()}
     rows = [{"supply_model": model_of[row["plant"]], **row} for row in summarise(records)]
     line = variants["line"].params.supply_line
