@@ -844,7 +844,7 @@ def test_ray_failing_to_connect_is_not_read_as_a_file_that_cannot_be_written(mon
     monkeypatch.setattr(ray, "cluster_resources", lambda: {"CPU": 1})
     monkeypatch.setattr(ray, "remote", lambda function: type("Remote", (), {"remote": lambda self, chunk: chunk})())
     monkeypatch.setattr(ray, "wait", lambda pending, num_returns: refuse())
-    monkeypatch.setattr(ray, "cancel", lambda ref: None)
+    monkeypatch.setattr(ray, "cancel", lambda ref: refuse())  # a lost cluster refuses the clean-up too
     with pytest.raises(sweep.ClusterUnreachable, match="^lost or could not reach the Ray cluster at auto"):
         sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)
 

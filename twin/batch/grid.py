@@ -71,13 +71,13 @@ def parse_axis(name: str, value) -> list:
         raise InvalidScenario(f"unknown sweep axis {name!r}: choose from {', '.join(AXES)}")
     items: Iterable = value if isinstance(value, list) else str(value).split(",")
     kind = NUMERIC.get(name, str)
-    out: list = []
+    out: dict = {}  # the distinct values in the order given ("0,0" is one value)
     for item in items:
         text = str(item).strip()
         flag = f"--{name.replace('_', '-')}"
         try:
             if kind is not str and ":" in text:
-                out += _range(text, kind, flag)
+                out.update(dict.fromkeys(_range(text, kind, flag)))
             elif name == "seed" and "-" in text.lstrip("-"):
                 low, high = (int(x) for x in text.split("-"))
                 if high < low:
@@ -85,13 +85,11 @@ def parse_axis(name: str, value) -> list:
                 if high - low + 1 > MAX_POINTS:
                     raise InvalidScenario(f"range {text!r} for {flag} has {high - low + 1:,} values: more than "
                                           f"the {MAX_POINTS:,} scenarios a sweep takes")
-                out += list(range(low, high + 1))
+                out.update(dict.fromkeys(range(low, high + 1)))
             else:
-                out.append(kind(text) if kind is str else _number(text, kind))
+                out[kind(text) if kind is str else _number(text, kind)] = None
             if len(out) > MAX_POINTS:  # many ranges, each under the cap: their distinct values refused together
-                out = list(dict.fromkeys(out))
-                if len(out) > MAX_POINTS:
-                    raise InvalidScenario(f"{flag} has more than the {MAX_POINTS:,} values a sweep takes")
+                raise InvalidScenario(f"{flag} has more than the {MAX_POINTS:,} values a sweep takes")
         except InvalidScenario:
             raise
         except ValueError:
@@ -99,7 +97,7 @@ def parse_axis(name: str, value) -> list:
             raise InvalidScenario(f"bad value {text!r} for --{name.replace('_', '-')}{expected}") from None
     if not out:
         raise InvalidScenario(f"--{name.replace('_', '-')} is empty")
-    return list(dict.fromkeys(out))  # "0,0" is one value
+    return list(out)
 
 
 def read_toml(path) -> dict[str, list]:

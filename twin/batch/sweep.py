@@ -17,6 +17,7 @@ whatever the backend, worker count or chunking.
 from __future__ import annotations
 
 import concurrent.futures
+import contextlib
 import dataclasses
 import hashlib
 import importlib.metadata
@@ -234,11 +235,13 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
         while pending:
             done, pending = cluster(ray.wait, pending, num_returns=1)
             on_done(cluster(ray.get, done[0]))
-    finally:
-        for ref in pending:
-            ray.cancel(ref)
+    finally:  # best effort: a cluster already lost refuses these too, and must not hide why the sweep stopped
+        with contextlib.suppress(ConnectionError):
+            for ref in pending:
+                ray.cancel(ref)
         if started_here:
-            ray.shutdown()
+            with contextlib.suppress(ConnectionError):
+                ray.shutdown()
 
 
 def run_sweep(points: Sequence[GridPoint], *, out: pathlib.Path, workers: int | None = None,

@@ -37,7 +37,7 @@ def supply_variants(base: Plant) -> dict[str, Plant]:
 
 def supply_study(*, trajectories: Sequence[int] = (1, 3), seeds: int = 3, plant_name: str = "as-built",
                  bar=None) -> Outcome:
-    """FF + PVA and sliding mode on ``trajectories`` with each supply model, ``seeds`` runs each, one batch;
+    """FF + PVA and sliding mode on ``trajectories`` with each supply model, ``seeds`` runs each, in parts;
     ``bar`` (a tqdm bar, optional) is given the number of scenarios before they run, then counts them."""
     from twin.envs.runner import run_many
     from twin.sim.simulation import in_parts
