@@ -88,16 +88,12 @@ def counted(n: int, noun: str) -> str:
     return f"{n} {noun}{'' if n == 1 else 's'}"
 
 
-def _hundredths(value: float) -> str:
-    return signed(value, 6)
-
-
 def format_summary(summary: Sequence[dict], limit: int = 40) -> str:
     lines = [f"{'controller':10} {'T':>2} {'payload g':>9} {'orient':>10} {'plant':>8} {'kPa':>5} {'PWM ms':>6} "
              f"{'runs':>4} {'fail':>4} {'RMSE mean±std':>14} {'SSE range':>16}"]
     for s in summary[:limit]:
         sse_range = ("   - (ends moving)" if math.isnan(s["sse_min_deg"])
-                     else f"[{_hundredths(s['sse_min_deg'])},{_hundredths(s['sse_max_deg'])}]")
+                     else f"[{signed(s['sse_min_deg'], 6)},{signed(s['sse_max_deg'], 6)}]")
         lines.append(
             f"{s['controller']:10} {s['trajectory']:>2} {s['payload_g']:>9g} {s['orientation']:>10} {s['plant']:>8} "
             f"{'-' if s['supply_kpa'] is None else format(s['supply_kpa'], 'g'):>5} "

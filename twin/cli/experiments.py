@@ -7,9 +7,8 @@ import argparse
 import sys
 
 from twin.cli.common import EXIT_INTERRUPTED, Parser, output_folder
-from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
-from twin.experiments.base import Experiment, tell_undrawn
+from twin.experiments.base import Experiment, refuse_folders_in_the_way, tell_undrawn
 from twin.experiments.studies import STUDIES
 from twin.experiments.whatifs import WHATIFS
 
@@ -20,9 +19,7 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
     again, while it still holds the folder's lock, when it stops without its results, unless the
     experiment is resumable (its store may hold finished runs, whatever stopped it)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
-    for name in experiment.file_names():  # staged() checks every file it writes again before any moves in
-        if (args.out / name).is_dir():
-            raise InvalidScenario(f"cannot write {args.out / name}: a folder is in the way of this file")
+    refuse_folders_in_the_way(args.out, experiment.file_names())  # staged() checks what it wrote again
     with output_folder(args.out, keep_on_failure=experiment.resumable):
         try:
             outcome = experiment.run(args, args.out)

@@ -34,9 +34,9 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
                               "or use --backend local")
     if args.ray_address is not None and args.backend != "ray":
         raise InvalidScenario("--ray-address: only with --backend ray (this sweep would run locally)")
-    if args.backend == "ray" and (args.ray_address or os.environ.get("RAY_ADDRESS")):
-        check_ray_address(args.ray_address or os.environ["RAY_ADDRESS"],
-                          "--ray-address" if args.ray_address else "RAY_ADDRESS")
+    address = args.ray_address or os.environ.get("RAY_ADDRESS")
+    if args.backend == "ray" and address:
+        check_ray_address(address, "--ray-address" if args.ray_address else "RAY_ADDRESS")
     # one writer per folder (a second sweep into it is refused, naming this one); SIGTERM stops it as Ctrl-C
     # does; the folder stays whatever stops the sweep: its store keeps the finished scenarios
     with output_folder(args.out, keep_on_failure=True):

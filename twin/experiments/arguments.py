@@ -81,6 +81,8 @@ workers = checked(int, lambda v: 1 <= v <= MAX_WORKERS,
 port = checked(int, lambda v: 0 <= v <= 65535, "port must be an integer in [0, 65535]")
 speed = checked(float, lambda v: 0 < v <= 10, "speed must be in (0, 10] times real time")
 seconds = checked(float, lambda v: v > 0, "duration must be a positive number of seconds")
+
+
 def host(text: str) -> str:
     """``--host``: a name or address, not empty (which listened on every interface, unsaid) nor padded."""
     if not text or text.strip() != text:

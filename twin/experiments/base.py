@@ -130,9 +130,7 @@ def staged(out: pathlib.Path, prefix: str):
     stage = Staging(pathlib.Path(tempfile.mkdtemp(prefix=f".{prefix}-", dir=out)))
     try:
         yield stage
-        for name in stage.names:  # a folder where a file goes: refused before any file of the set moves
-            if (out / name).is_dir():
-                raise IsADirectoryError(errno.EISDIR, "a folder is in the way of this file", str(out / name))
+        refuse_folders_in_the_way(out, stage.names)  # before any file of the set moves
     except BaseException:
         shutil.rmtree(stage.folder, ignore_errors=True)
         raise
@@ -144,6 +142,13 @@ def staged(out: pathlib.Path, prefix: str):
                 (out / name).unlink(missing_ok=True)
         finally:
             shutil.rmtree(stage.folder, ignore_errors=True)
+
+
+def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:
+    """Raise IsADirectoryError (an OSError naming the path) if any of ``names`` in ``out`` is a folder."""
+    for name in names:
+        if (out / name).is_dir():
+            raise IsADirectoryError(errno.EISDIR, "a folder is in the way of this file", str(out / name))
 
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)

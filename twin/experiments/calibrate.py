@@ -169,19 +169,16 @@ def unit_of(values: dict[str, float]) -> tuple[float, ...]:
 
 
 def _run_cells(values: dict[str, float], jobs: list[tuple], without: tuple[str, ...] = ()) -> list[tuple]:
-    from twin.envs.runner import run_many
+    from twin.envs.runner import thesis_controllers
     from twin.physics.model import Orientation
-    from twin.sim.simulation import in_parts
+    from twin.sim.simulation import simulate_in_parts
 
     plant = as_built_plant(values, name="as-built-fit", without=without)
-
-    def work(part: list[tuple]) -> list[tuple]:  # a part's runs, then only their numbers
-        results = run_many([Scenario(c, t, payload=g * 1e-3, orientation=Orientation(o), plant=plant, seed=s)
-                            for c, t, g, o, s in part], nthread=1)
-        return [(*job[:4], job[4], math.degrees(r.metrics.rmse), math.degrees(r.metrics.sse), bool(r.warnings),
-                 math.degrees(r.metrics.max_error)) for job, r in zip(part, results, strict=True)]
-
-    return in_parts(jobs, work)
+    scenarios = [Scenario(c, t, payload=g * 1e-3, orientation=Orientation(o), plant=plant, seed=s)
+                 for c, t, g, o, s in jobs]
+    numbers = simulate_in_parts(scenarios, controllers=thesis_controllers(scenarios), nthread=1, keep=lambda r: (
+        math.degrees(r.metrics.rmse), math.degrees(r.metrics.sse), bool(r.warnings), math.degrees(r.metrics.max_error)))
+    return [(*job[:4], job[4], *kept) for job, kept in zip(jobs, numbers, strict=True)]
 
 
 class Evaluator:

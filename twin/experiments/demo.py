@@ -22,7 +22,7 @@ import sys
 import numpy as np
 from tqdm import tqdm
 
-from twin.batch.tables import signed
+from twin.batch.tables import counted, signed
 from twin.envs.runner import run_many
 from twin.experiments.base import staged, tell_undrawn
 from twin.experiments.reference import (
@@ -132,7 +132,7 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
                     writer = csv.DictWriter(handle, fieldnames=list(record))
                     writer.writeheader()
                 writer.writerow(record)
-        (stage.folder / "summary.md").write_text(f"{SUMMARY_TITLE} ('thesis' plant, {seeds} seed{'' if seeds == 1 else 's'})\n\n{table}\n")
+        (stage.folder / "summary.md").write_text(f"{SUMMARY_TITLE} ('thesis' plant, {counted(seeds, 'seed')})\n\n{table}\n")
         stage.names += ["results.csv", "summary.md"]
         if plots:
             from viz.plots import plot_run

@@ -36,7 +36,7 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from twin.batch.tables import signed, write_csv
+from twin.batch.tables import counted, signed, write_csv
 from twin.experiments import calibrate
 from twin.experiments.base import Experiment, Outcome, drawn
 from twin.experiments.reference import (
@@ -1445,19 +1445,15 @@ def _why(v: Validation) -> list[str]:
     return lines
 
 
-def _runs(n: int) -> str:
-    return f"{n} run{'' if n == 1 else 's'}"
-
-
 def _times(ratio) -> str:
     """A twin / measured ratio as the report writes it (x1.31), or "failed" for a mean that is not a number."""
     return "failed" if ratio is None or not math.isfinite(ratio) else f"x{ratio:.2f}"
 
 
-def _in_short(v: Validation) -> list[str]:
+def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
     """The report's opening: what is within the bar, what is not (each miss's size and reading), and what the
     blind prediction says, in three lines computed from the same rows as the tables below. Added 2026-11-27,
-    after every result it reads: it says again what the tables say, in short."""
+    after every result it reads: it says again what the tables say, in short. ``missed``: :func:`misses` of ``v``."""
     measured = [r for r in v.rows if r["source"] in ("chapter 5 experiment", "chapter 6 T1")]
     within = [r for r in measured if r["within_tolerance"]]
     parts = ", ".join(f"{label} {sum(r['within_tolerance'] for r in rs)} of {len(rs)}"
@@ -1471,14 +1467,13 @@ def _in_short(v: Validation) -> list[str]:
         first += (f"; of the vertical cells with a payload, {sum(r['within_tolerance'] for r in heavy)} of "
                   f"{len(heavy)} RMSE means")
     first += (", and no run of the measured cells stalls." if not stalled else
-              f"; {_runs(stalled)} of the measured cells stall{'s' if stalled == 1 else ''}.")
+              f"; {counted(stalled, 'run')} of the measured cells stall{'s' if stalled == 1 else ''}.")
     checked = [r for r in v.rows if r["source"].startswith("4.4.3 valve test") and "below" not in r["source"]]
     delays = [r for r in v.rows if r["source"].startswith("4.4.3 valve") and "delay" in r["source"]]
     if checked or delays:
         first += (f" The valve: R(d) within 15 % of eq. 4.4.2 at {sum(r['within_tolerance'] for r in checked)} of "
                   f"{len(checked)} duties from 35 %, delays within 1 ms on {sum(r['within_tolerance'] for r in delays)}"
                   f" of {len(delays)}.")
-    missed = misses(v)
     rmse = [m for m in missed if m["comparison"] == "RMSE" and m["missed_on"] == "seeds 0-4"]
     orders = [m for m in missed if m["comparison"] == "controller order" and m["missed_on"] == "seeds 0-4"]
     sse = [r for r in v.rows if r["source"].endswith("T1 SSE range")]
@@ -1518,11 +1513,11 @@ def _in_short(v: Validation) -> list[str]:
             best = min(p, key=p.get)
             leads[best] = leads.get(best, 0) + 1
         stalls = sum(r["stalled_runs"] for r in v.prediction)
-        lines.append(f"- **Blind T3 prediction** ({len(v.prediction)} cell{'s' if len(v.prediction) > 1 else ''}): "
+        lines.append(f"- **Blind T3 prediction** ({counted(len(v.prediction), 'cell')}): "
                      + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {len(both)} payload and side cells"
                                   for c, n in sorted(leads.items())) + " (the committed preset); " if both else "")
                      + ("no run of any ensemble member stalls." if not stalls else
-                        f"{_runs(stalls)} of the ensemble's members stall{'s' if stalls == 1 else ''}."))
+                        f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}."))
     return lines
 
 
@@ -1533,6 +1528,7 @@ def report(v: Validation) -> str:
     for r in rows:
         head = "4.4.3 valve test" if r["source"].startswith("4.4.3") else r["source"].split(" (")[0]
         groups.setdefault(head, []).append(r)
+    missed = misses(v)
     lines = ["# How far to trust the twin", "",
              "Written by `twin validate`. Every published comparison the twin can be held to, run from this "
              "code and the committed as-built calibration, and the blind prediction of the Chapter 6 T3 cells. "
@@ -1541,7 +1537,7 @@ def report(v: Validation) -> str:
              "`within` is each comparison's tolerance: ±0.35 deg for the thesis's simulations, 20 % for measured "
              "RMSE means, ±0.5 deg for T1 steady-error ranges, 15 % for the valve's R(d) from 35 % duty, 1 ms "
              "for the valve's delays.", "",
-             "## In short", "", *_in_short(v), "",
+             "## In short", "", *_in_short(v, missed), "",
              "## Summary", "", "| comparison | plant | within tolerance |", "|---|---|---|"]
     for head, members in groups.items():
         lines.append(f"| {head} | {members[0]['plant']} | {sum(r['within_tolerance'] for r in members)} of "
@@ -1555,7 +1551,6 @@ def report(v: Validation) -> str:
             lines.append(f"| T1 SSE range, mean of the five-run ranges on seeds {v.seeds[0]['seeds']} (a check) | "
                          f"as-built | {sum(r['sse_within_tolerance'] for r in sse)} of {len(sse)} |")
     lines += ["", "![twin against measurement](validation.png)", ""]
-    missed = misses(v)
     if missed:
         lines += ["## Every miss against the bar, and what the other checks show about it", "",
                   f"Each comparison the bar judges (an RMSE mean within {RMSE_TOLERANCE * 100:.0f} %, a T1 steady-error "

@@ -91,13 +91,18 @@ RUN_PART = 200  # runs simulated at once where a command's runs can be many: a r
 # 1.2 MB on T1-T3) until its batch ends, and one batch of 99,000 ran out of 20 GB (2026-11-27)
 
 
-def in_parts(items: Sequence, work: Callable[[Sequence], list]) -> list:
-    """``work`` on consecutive parts of at most :data:`RUN_PART` of ``items``, its lists joined, so that memory holds
-    one part's runs, not all. Each run is its own (its seed, its state), so the numbers are one batch's (tested)."""
-    out: list = []
-    for start in range(0, len(items), RUN_PART):
-        out += work(items[start:start + RUN_PART])
-    return out
+def simulate_in_parts(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller], keep: Callable,
+                      progress_of: Callable[[int], Callable | None] | None = None, nthread: int = 0) -> list:
+    """``keep(result)`` of each scenario's run, in order, simulated :data:`RUN_PART` at a time so that memory
+    holds one part's traces, not all; ``progress_of(count)`` gives each part's ``progress`` (as for
+    :func:`simulate`). Each run is its own (its seed, its state), so the numbers are one batch's (tested)."""
+    kept: list = []
+    for start in range(0, len(scenarios), RUN_PART):
+        part = slice(start, start + RUN_PART)
+        results = simulate(scenarios[part], controllers=controllers[part], nthread=nthread,
+                           progress=None if progress_of is None else progress_of(len(scenarios[part])))
+        kept += [keep(r) for r in results]
+    return kept
 
 
 def simulate(scenarios: Sequence[Scenario], *, controllers: Sequence[Controller],

@@ -53,17 +53,11 @@ def number_list(text: str, flag: str, what: str, convert=float) -> list:
 
 
 def simulate_in_parts(scenarios: Sequence, controllers: Sequence, keep: Callable, bar=None) -> list:
-    """``keep(result)`` of each scenario's run, in order, simulated in parts
-    (:func:`twin.sim.simulation.in_parts`) so that memory holds one part's traces; ``bar`` (tqdm, or None)
-    counts the runs."""
-    from twin.sim.simulation import in_parts, simulate
+    """:func:`twin.sim.simulation.simulate_in_parts` with ``bar`` (tqdm, or None) counting the runs."""
+    from twin.sim import simulation
 
-    def work(indices: range) -> list:
-        results = simulate([scenarios[i] for i in indices], controllers=[controllers[i] for i in indices],
-                           progress=batch_progress(bar, len(indices)))
-        return [keep(r) for r in results]
-
-    return in_parts(range(len(scenarios)), work)
+    return simulation.simulate_in_parts(list(scenarios), controllers=list(controllers), keep=keep,
+                                        progress_of=lambda count: batch_progress(bar, count))
 
 
 def batch_progress(bar, count: int):

@@ -86,6 +86,11 @@ def add_ensemble_arguments(parser, *, seeds: int) -> None:
                         help="only the first N calibration ensemble members (default: all)")
 
 
+def members_to_run(members: int | None) -> int:
+    """``--members``: the first ``members`` of the ensemble, or all of them."""
+    return member_count() if members is None else members
+
+
 def member_count() -> int:
     from twin.plants.as_built import ensemble_values
 
@@ -115,7 +120,7 @@ def over_ensemble(batch: Callable, cases: Sequence, *, seeds: Sequence[int], wor
     """``batch(plant, cases, seeds) -> {(case, seed): Run}`` (a module-level function, so it reaches
     the workers) on every ensemble member (or the first ``members``), members in parallel on
     ``workers`` processes; ``progress()`` after each member. One dict per member, in member order."""
-    count = member_count() if members is None else members
+    count = members_to_run(members)
     done: dict[int, dict] = {}
     if workers <= 1:
         for m in range(count):
@@ -138,7 +143,7 @@ def run_cases(batch: Callable, cases: Sequence, *, seeds: Sequence[int], members
               workers: int = 2, bar=None) -> tuple[list[dict], int]:
     """:func:`over_ensemble` with a progress ``bar`` (tqdm, optional) given the number of runs first and
     counting them; also the number of members run."""
-    count = member_count() if members is None else members
+    count = members_to_run(members)
     per_member_runs = len(cases) * len(seeds)
     if bar is not None:
         bar.reset(total=count * per_member_runs)

@@ -94,23 +94,26 @@ def _bisection_steps(closed: np.ndarray, can: np.ndarray, tolerance: float) -> i
     return steps
 
 
-def planned_runs(pressures_kpa: Sequence[float], plant_name: str, tolerance: float = LIFT_TOLERANCE) -> int:
-    """The most runs :func:`lift_study` makes: the bare link and the thesis payload at every pressure, then every
-    bisection step at each pressure whose closed form lifts anything."""
+def closed_forms(pressures_kpa: Sequence[float], plant_name: str) -> tuple[np.ndarray, np.ndarray]:
+    """The distinct pressures (Pa, sorted, so rows and answer run upwards) and each one's closed-form lift (kg)."""
     params = plant(plant_name).params
-    closed = np.array([lift_limit_closed_form(params, p * 1e3) for p in np.unique(np.array(pressures_kpa, dtype=float))])
+    pressures = np.unique(np.array(pressures_kpa, dtype=float)) * 1e3
+    return pressures, np.array([lift_limit_closed_form(params, p) for p in pressures])
+
+
+def planned_runs(closed: np.ndarray, tolerance: float = LIFT_TOLERANCE) -> int:
+    """The most runs :func:`lift_study` makes for these closed forms: the bare link and the thesis payload at
+    every pressure, then every bisection step at each pressure whose closed form lifts anything."""
     return 2 * closed.size + int(np.sum(closed > 0)) * _bisection_steps(closed, closed > 0, tolerance)
 
 
 def lift_study(*, pressures_kpa: Sequence[float], plant_name: str = "thesis", tolerance: float = LIFT_TOLERANCE,
                bar=None) -> Outcome:
     """``bar`` (a tqdm bar, optional) is given the number of scenarios before any runs, then counts them."""
-    params = plant(plant_name).params
-    pressures = np.unique(np.array(pressures_kpa, dtype=float)) * 1e3  # sorted, so rows and answer run upwards
+    pressures, closed = closed_forms(pressures_kpa, plant_name)
     n = len(pressures)
-    closed = np.array([lift_limit_closed_form(params, p) for p in pressures])
     if bar is not None:  # the bare link and the thesis payload at every pressure, then the bisection (at most)
-        bar.reset(total=planned_runs(pressures_kpa, plant_name, tolerance))
+        bar.reset(total=planned_runs(closed, tolerance))
 
     def lifts(payloads: np.ndarray, at: np.ndarray) -> np.ndarray:
         return _lifts(payloads, at, plant_name, bar)
@@ -177,7 +180,7 @@ class LiftWhatIf(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         args.pressure_values = list_flag(args, "--pressures", "pressures", "supply_kpa")
-        refuse_oversized(planned_runs(args.pressure_values, args.plant), "--pressures")
+        refuse_oversized(planned_runs(closed_forms(args.pressure_values, args.plant)[1]), "--pressures")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

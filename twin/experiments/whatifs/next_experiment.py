@@ -217,7 +217,7 @@ def cell_label(cell: tuple) -> str:
 
 def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure_step: float = 10e3,
                           members: int | None = None, workers: int = 2, bar=None) -> Outcome:
-    count = ensemble.member_count() if members is None else members
+    count = ensemble.members_to_run(members)
     if count < 2:
         raise InvalidScenario("--members: the refit needs at least 2 ensemble members")
     seed_list = tuple(range(100, 100 + seeds))  # runs of the virtual rig: apart from the prediction's seeds
@@ -322,7 +322,7 @@ class NextExperimentWhatIf(Experiment):
             raise InvalidScenario("--seeds: the spread within a member needs at least 2 seeds")
         if not (math.isfinite(args.pressure_step) and 1.0 <= args.pressure_step <= 100.0):
             raise InvalidScenario(f"--pressure-step: 1-100 kPa, got {args.pressure_step:g}")
-        members = ensemble.member_count() if args.members is None else args.members
+        members = ensemble.members_to_run(args.members)
         rounds = math.ceil(math.log2(len(ladder(args.pressure_step * 1e3)) + 1))  # a map's bisection, at most
         per_seed = len(MAPS) * len(MAP_ANGLES_DEG) * rounds + 1  # the two maps' positions each round, the sine
         refuse_oversized(members * (args.seeds * per_seed + args.prediction_seeds * len(ROBUSTNESS_CELLS)),

@@ -136,7 +136,7 @@ class ObserverWhatIf(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         ensemble.check_members(args.members)
-        members = ensemble.member_count() if args.members is None else args.members
+        members = ensemble.members_to_run(args.members)
         refuse_oversized(len(CONTROLLERS) * len(TRAJECTORIES) * len(OBSERVER_KINDS) * args.seeds * members,
                          "--seeds x --members")
 

@@ -189,7 +189,7 @@ class PvaRateWhatIf(Experiment):
     def check(self, args: argparse.Namespace) -> None:
         args.rate_values = parse_rates(args.rates)
         ensemble.check_members(args.members)
-        members = ensemble.member_count() if args.members is None else args.members
+        members = ensemble.members_to_run(args.members)
         refuse_oversized(len(ensemble.study_cells()) * len(args.rate_values) * args.seeds * members,
                          "--rates x --seeds x --members")
 

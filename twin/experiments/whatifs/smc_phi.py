@@ -81,7 +81,7 @@ def phi_study(*, phis: Sequence[float], seeds: int = 10, plant_name: str = "as-b
     base = plant(plant_name)
     nominal = nominal_model(base)
     thesis = controllers.make_controller("smc", nominal=nominal, gain_set=base.gain_set, tick=base.timestep)
-    phis = tuple(sorted(set(phis) | {plant_phi(base)}))
+    phis = tuple(sorted(set(phis) | {thesis.gains.boundary_layer}))
     laws = {("smc", phi): dataclasses.replace(thesis, gains=dataclasses.replace(thesis.gains, boundary_layer=phi))
             for phi in phis}
     laws[("ffpva", None)] = controllers.make_controller("ffpva", nominal=nominal, gain_set=base.gain_set,
@@ -197,11 +197,12 @@ class SmcPhiWhatIf(Experiment):
         from twin.plants import plant
 
         args.phi_values = parse_phis(args.phis)
-        laws = len(set(args.phi_values) | {plant_phi(plant(args.plant))}) + 1  # the plant's own phi, and FF + PVA
-        refuse_oversized(laws * len(measured_cells()) * args.seeds, "--phis x --seeds")
-        if plant(args.plant).gain_set != "experiment":
+        base = plant(args.plant)
+        if base.gain_set != "experiment":
             raise InvalidScenario(f"--plant {args.plant} runs the thesis's simulation gains; smc-phi compares with the "
                                   "rig's measurements, so it needs a plant with the experiment gains (as-built)")
+        laws = len(set(args.phi_values) | {plant_phi(base)}) + 1  # the plant's own phi (phi_study's), and FF + PVA
+        refuse_oversized(laws * len(measured_cells()) * args.seeds, "--phis x --seeds")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         with progress_bar(self.name) as bar:

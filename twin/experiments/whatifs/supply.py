@@ -15,7 +15,7 @@ import numpy as np
 from twin.batch.tables import counted, signed, summarise
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
-from twin.experiments.whatifs.common import add_common_arguments, batch_progress, progress_bar
+from twin.experiments.whatifs.common import add_common_arguments, progress_bar, simulate_in_parts
 from twin.physics.params import NOMINAL_PARAMS
 from twin.plants import Plant, plant
 from twin.sim import report
@@ -39,20 +39,16 @@ def supply_study(*, trajectories: Sequence[int] = (1, 3), seeds: int = 3, plant_
                  bar=None) -> Outcome:
     """FF + PVA and sliding mode on ``trajectories`` with each supply model, ``seeds`` runs each, in parts;
     ``bar`` (a tqdm bar, optional) is given the number of scenarios before they run, then counts them."""
-    from twin.envs.runner import run_many
-    from twin.sim.simulation import in_parts
+    from twin.envs.runner import thesis_controllers
 
     variants = supply_variants(plant(plant_name))
     cases = [(Scenario(c, t, plant=variants[m], seed=s), m)
              for m in SUPPLY_MODELS for c in MODEL_BASED_CONTROLLERS for t in trajectories for s in range(seeds)]
     if bar is not None:
         bar.reset(total=len(cases))
-    def work(part: list) -> list[dict]:  # a part's runs, then only their summaries
-        results = run_many([s for s, _ in part], progress=batch_progress(bar, len(part)))
-        return [{**report.summary(r), "pwm_period_ms": None, "status": "failed" if r.warnings else "ok"}
-                for r in results]
-
-    records = in_parts(cases, work)
+    scenarios = [s for s, _ in cases]
+    records = simulate_in_parts(scenarios, thesis_controllers(scenarios), lambda r: {
+        **report.summary(r), "pwm_period_ms": None, "status": "failed" if r.warnings else "ok"}, bar)
     model_of = {variant.name: model for model, variant in variants.items()}
     rows = [{"supply_model": model_of[row["plant"]], **row} for row in summarise(records)]
     line = variants["line"].params.supply_line
