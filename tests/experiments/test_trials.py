@@ -349,3 +349,82 @@ def test_trial_chamber_buildup_prints_what_the_docs_quote(capsys):
         "leak 1.2e-13":
             "1.149 / 0.834 / 1.022 / 0.877 | +0.232 (-0.018 to +0.590) | 15 | 1.72 (7.4), 2.18, 2.07, 1.34 | 18 | 1.84 / 2.25 / 2.42 / 1.94 / 2.28 / 3.34; 2.10 / 2.42 / 2.50 / 2.10 / 2.47 / 3.41",
     }
+
+
+def test_trial_air_box_changes_only_the_air_top_and_puts_calibrate_back(monkeypatch):
+    from twin.experiments import calibrate
+
+    trial = _load("trial_air_box")
+    box = {f.name: f for f in trial.trial_box()}
+    committed = {f.name: f for f in calibrate.FITTED}
+    assert box["air_fraction"].high == trial.AIR_TOP == 0.08 and box["air_fraction"].low == 0.0
+    assert {n: (f.low, f.high) for n, f in box.items() if n != "air_fraction"} == {
+        n: (f.low, f.high) for n, f in committed.items() if n != "air_fraction"}
+    assert trial.PROFILED == (*calibrate.PROFILED, "air_fraction") and trial.ENSEMBLE_MAX == 11
+    seen = {}
+
+    def failing(**kwargs):
+        seen["box"], seen["profiled"] = calibrate.FITTED, calibrate.PROFILED
+        raise RuntimeError("stopped")
+
+    before = calibrate.FITTED, calibrate.PROFILED
+    monkeypatch.setattr(calibrate, "calibrate", failing)
+    with pytest.raises(RuntimeError):
+        trial.run(workers=1)
+    assert seen["box"] == trial.trial_box() and seen["profiled"] == trial.PROFILED  # the search saw the trial's
+    assert (calibrate.FITTED, calibrate.PROFILED) == before  # and calibrate is as it was after a failure
+
+
+@pytest.mark.slow  # about 3 min on 2 cores: one evaluation of the fit, the T3 report, then twin validate on the file
+def test_trial_air_box_prints_and_writes_what_the_docs_quote(capsys, tmp_path):
+    from twin.experiments import calibrate
+
+    trial = _load("trial_air_box")
+    folder = ROOT / "examples" / "trial_air_box"
+    data = trial.json.loads((folder / "as_built.json").read_text())
+    # The file is the trial's: its box and profiles, and its best values cost what it says on the fit's seeds.
+    assert data["bounds"]["air_fraction"]["high"] == trial.AIR_TOP and "air_fraction" in data["made_by"]
+    assert len(data["ensemble"]) == trial.ENSEMBLE_MAX
+    with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=2) as evaluator:
+        assert calibrate.cost(evaluator.cells(data["fitted"])) == pytest.approx(data["cost"], rel=1e-12)
+    trial.main(["--calibration", str(folder / "as_built.json"), "--out", str(tmp_path)])
+    out = capsys.readouterr().out.splitlines()
+    assert out[1].startswith("cost 0.5367, noise 0.1394 (costs 0.5367, 0.8600, 0.7446, 0.7925)")
+    assert out[2] == "measured cells within 20 % on seeds 0-4 (best): 17 of 21"
+    t3 = {" ".join(line.split()[:4]): line.split()[4:] for line in out if line.startswith(("  ffpva", "  smc"))}
+    assert t3["ffpva 0 g horizontal"] == ["2.38", "2.29-2.38", "2.23-2.42", "0"]
+    assert t3["ffpva 13.5 g vertical"] == ["3.66", "3.66-3.81", "3.62-4.20", "0"]
+    assert t3["smc 0 g horizontal"] == ["2.21", "2.19-2.23", "2.16-2.23", "0"]
+    assert t3["smc 6.5 g horizontal"] == ["2.42", "2.36-2.44", "2.35-2.50", "0"]
+    assert t3["smc 13.5 g vertical"] == ["3.42", "3.38-3.48", "3.36-3.84", "0"]
+    leads = [line.split()[-1] for line in out if line.startswith("  air ")]
+    assert leads == ["SSSSSS"] * 11  # sliding mode ahead in all six cells on every member
+    for name in ("prediction.csv", "prediction_members.csv"):  # the registered prediction, byte for byte
+        assert (tmp_path / name).read_bytes() == (folder / name).read_bytes(), name
+    assert trial.validate_on(folder / "as_built.json", tmp_path / "v", 2) == 0  # twin validate on the trial's file
+    for name in ("validation.csv", "misses.csv", "prediction.csv"):  # as kept, and its prediction the script's
+        assert (tmp_path / "v" / name).read_bytes() == (folder / name).read_bytes(), name
+    assert "right on 4 of 4 trajectories" in (tmp_path / "v" / "validation.md").read_text()
+
+
+def test_trial_air_box_validates_on_its_own_file_and_puts_the_preset_back(monkeypatch, tmp_path):
+    import twin.cli
+    from twin.plants import as_built
+
+    trial = _load("trial_air_box")
+    kept = ROOT / "examples" / "trial_air_box" / "as_built.json"
+    before = {n: getattr(as_built, n) for n in ("FITTED", "calibrated_values", "ensemble_values")}
+    committed = as_built.calibrated_values()
+    seen = {}
+
+    def fake_main(argv):
+        seen["argv"], seen["values"] = argv, as_built.calibrated_values()
+        seen["members"] = len(as_built.ensemble_values())
+        raise RuntimeError("stopped")
+
+    monkeypatch.setattr(twin.cli, "main", fake_main)
+    with pytest.raises(RuntimeError):
+        trial.validate_on(kept, tmp_path / "v", 1)
+    assert seen["argv"] == ["validate", "--out", str(tmp_path / "v"), "--workers", "1"]
+    assert seen["values"]["air_fraction"] == 0.046 and seen["members"] == 11  # the trial's file, outside 3 %
+    assert {n: getattr(as_built, n) for n in before} == before and as_built.calibrated_values() == committed
