@@ -9,8 +9,9 @@ about as well and turning which law leads on T3 (docs/prediction.md).
 This script runs the same search as ``twin calibrate`` (scan, simplex, noise, profiles, ensemble; the same
 seeds and budgets) with two changes, fixed before it was first run:
 
-* the air's box is 0-8 %: wide enough that the data, not the box, bound it (in `twin whatif air` the
-  committed values cost, set by set, 0.65 more at 1 % and 0.21 more at 8 % than at 2.83 %);
+* the air's box is 0-8 %: wide enough that the data, not the box, bound it (in
+  ``examples/trial_chamber_buildup.py`` the committed values cost, set by set, 0.65 more at 1 % and 0.21 more at
+  8 % than at 2.83 %, on average over four seed sets);
 * the air is profiled last, after the four parameters ``twin calibrate`` profiles (five points: 0, 2, 4, 6
   and 8 %), and the ensemble may hold its two extremes (at most 11 members: the best and each profiled
   parameter's two).
@@ -22,8 +23,9 @@ within 20 % (seeds 0-4), and each T3 cell's committed value, band and which law 
 ``twin validate`` writes its own: ``prediction.csv``, ``prediction_members.csv``; ``twin score --prediction DIR``
 scores it). Those of 2026-11-27 are in ``examples/trial_air_box/``, and ``--calibration FILE`` reports a file
 without fitting again (about 1 min); with ``--validate DIR`` as well it runs ``twin validate --out DIR`` on that
-file instead of the committed preset (about 2-3 min; the committed preset is not touched).
-Nothing is installed: the committed preset and prediction stay as they are. About 8-13 min on 2 cores.
+file instead of the committed preset (1.5-3 min; the committed preset is not touched; the report still calls
+that file "the committed preset").
+Nothing is installed: the committed preset and prediction stay as they are. The fit takes 6-8 min on 2 cores.
 The result is recorded in docs/prediction.md and docs/calibration-history.md; a slow test in
 tests/experiments/test_trials.py holds the printed numbers.
 
@@ -126,22 +128,37 @@ def report(data: dict, workers: int, out: pathlib.Path | None = None) -> None:
 
 def validate_on(calibration: pathlib.Path, out: pathlib.Path, workers: int) -> int:
     """``twin validate --out OUT`` with the trial's ``calibration`` file in place of the committed preset (and the
-    trial's box, which its values must lie in); the committed preset is untouched, and put back after."""
-    import functools
+    trial's box, which its values must lie in); the committed preset is untouched, and put back after.
 
+    Every reader of the preset is pointed at ``calibration`` (one given the committed file's path too, as
+    ``preset_digest`` and ``ensemble_plants`` pass it on), and the plant registry's cached ``as-built`` plants
+    are set aside (``as-built`` is set to the trial's plant: a test may have left it cached with no lazy entry), so
+    that the plants `twin validate` looks up by name are the trial's; they are dropped and the cached ones put back
+    after."""
     from twin.cli import main as twin_main
-    from twin.plants import as_built
+    from twin.plants import ENSEMBLE_PREFIX, PLANTS, as_built
+
+    def pointed(read):
+        def on_trial(path: pathlib.Path = as_built.CALIBRATION_FILE):
+            return read(calibration if path == as_built.CALIBRATION_FILE else path)
+        return on_trial
 
     names = ("FITTED", "calibrated_values", "ensemble_values", "calibration_cost_line")
     saved = {name: getattr(as_built, name) for name in names}
-    as_built.FITTED = trial_box()
-    for name in names[1:]:
-        setattr(as_built, name, functools.partial(saved[name], calibration))
+    cached = dict(PLANTS._plants)  # the registry's loaded plants (private: a trial script, not the package)
     try:
+        for name in [n for n in PLANTS._plants if n.startswith(ENSEMBLE_PREFIX)]:
+            del PLANTS._plants[name]  # members are built again on asking, from the trial's file
+        as_built.FITTED = trial_box()
+        for name in names[1:]:
+            setattr(as_built, name, pointed(saved[name]))
+        PLANTS._plants["as-built"] = as_built.as_built_plant()  # the trial's, in place of any cached one
         return twin_main(["validate", "--out", str(out), "--workers", str(workers)])
     finally:
         for name, value in saved.items():
             setattr(as_built, name, value)
+        PLANTS._plants.clear()
+        PLANTS._plants.update(cached)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -155,8 +172,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
     if args.validate:
-        if not args.calibration:
-            parser.error("--validate needs --calibration FILE")
+        if not args.calibration or args.out:
+            parser.error("--validate needs --calibration FILE, and writes only to its own DIR (no --out)")
         raise SystemExit(validate_on(args.calibration, args.validate, args.workers))
     if args.calibration:
         data = json.loads(args.calibration.read_text())

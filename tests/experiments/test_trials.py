@@ -401,6 +401,9 @@ def test_trial_air_box_prints_and_writes_what_the_docs_quote(capsys, tmp_path):
     assert leads == ["SSSSSS"] * 11  # sliding mode ahead in all six cells on every member
     for name in ("prediction.csv", "prediction_members.csv"):  # the registered prediction, byte for byte
         assert (tmp_path / name).read_bytes() == (folder / name).read_bytes(), name
+    from twin.plants import plant
+
+    plant("as-built")  # cached in the registry, as after any earlier test: validate must not use it
     assert trial.validate_on(folder / "as_built.json", tmp_path / "v", 2) == 0  # twin validate on the trial's file
     for name in ("validation.csv", "misses.csv", "prediction.csv"):  # as kept, and its prediction the script's
         assert (tmp_path / "v" / name).read_bytes() == (folder / name).read_bytes(), name
@@ -409,17 +412,24 @@ def test_trial_air_box_prints_and_writes_what_the_docs_quote(capsys, tmp_path):
 
 def test_trial_air_box_validates_on_its_own_file_and_puts_the_preset_back(monkeypatch, tmp_path):
     import twin.cli
-    from twin.plants import as_built
+    from twin.plants import PLANTS, as_built, plant
 
     trial = _load("trial_air_box")
     kept = ROOT / "examples" / "trial_air_box" / "as_built.json"
-    before = {n: getattr(as_built, n) for n in ("FITTED", "calibrated_values", "ensemble_values")}
-    committed = as_built.calibrated_values()
+    names = ("FITTED", "calibrated_values", "ensemble_values", "calibration_cost_line")
+    before = {n: getattr(as_built, n) for n in names}
+    committed, committed_plant = as_built.calibrated_values(), plant("as-built")  # the registry has it cached
+    cached = dict(PLANTS._plants)
     seen = {}
 
     def fake_main(argv):
         seen["argv"], seen["values"] = argv, as_built.calibrated_values()
         seen["members"] = len(as_built.ensemble_values())
+        seen["plant"] = plant("as-built").params.chambers.air_fraction  # looked up by name, as validate does
+        seen["member"] = plant("as-built~1").params.chambers.air_fraction
+        seen["digest"] = as_built.preset_digest()  # passes the committed path on: still the trial's
+        seen["digest of the file"] = as_built.preset_digest(kept)
+        seen["line"] = as_built.calibration_cost_line()
         raise RuntimeError("stopped")
 
     monkeypatch.setattr(twin.cli, "main", fake_main)
@@ -427,4 +437,74 @@ def test_trial_air_box_validates_on_its_own_file_and_puts_the_preset_back(monkey
         trial.validate_on(kept, tmp_path / "v", 1)
     assert seen["argv"] == ["validate", "--out", str(tmp_path / "v"), "--workers", "1"]
     assert seen["values"]["air_fraction"] == 0.046 and seen["members"] == 11  # the trial's file, outside 3 %
-    assert {n: getattr(as_built, n) for n in before} == before and as_built.calibrated_values() == committed
+    assert seen["plant"] == 0.046 and seen["member"] == pytest.approx(0.0398, abs=5e-5)
+    assert seen["digest"] == seen["digest of the file"] != as_built.preset_digest()
+    assert seen["line"][0] == pytest.approx(0.5367, abs=1e-4)
+    # Afterwards: the committed preset everywhere, the registry's cached plant the same object, no trial member.
+    assert {n: getattr(as_built, n) for n in names} == before and as_built.calibrated_values() == committed
+    assert plant("as-built") is committed_plant and PLANTS._plants.keys() == cached.keys()
+    assert all(PLANTS._plants[name] is cached[name] for name in cached)  # the registry as it was, object for object
+    assert plant("as-built~1").params.chambers.air_fraction == committed["air_fraction"]
+
+
+def test_trial_air_box_writes_the_file_twin_calibrate_would_with_its_box(monkeypatch, tmp_path):
+    """The fit's success path, with the search stubbed by the kept file's own history: the ensemble of up to 11
+    is recomputed from it as the trial's file has it, and the file written has the trial's box and method."""
+    from twin.experiments import calibrate
+
+    trial = _load("trial_air_box")
+    kept = trial.json.loads((ROOT / "examples" / "trial_air_box" / "as_built.json").read_text())
+    history = [calibrate.Evaluation(h["values"], h["cost"], h["stage"]) for h in kept["history"]]
+
+    def searched(**kwargs):
+        assert calibrate.FITTED == trial.trial_box() and calibrate.PROFILED == trial.PROFILED
+        best = next(e for e in history if e.values == kept["fitted"])
+        return calibrate.Calibration(values=best.values, cost=best.cost, evaluations=len(history), history=history,
+                                     fit_cells=[], check_cells=[], noise_costs=kept["noise"]["costs"],
+                                     ensemble=[best], wall_time=1.0, max_evaluations=69,
+                                     fit_seeds=calibrate.FIT_SEEDS, check_seeds=(),
+                                     noise_seed_sets=calibrate.NOISE_SEED_SETS)
+
+    monkeypatch.setattr(calibrate, "calibrate", searched)
+    monkeypatch.setattr(trial, "report", lambda data, workers, out=None: None)
+    trial.main(["--out", str(tmp_path)])
+    written = trial.json.loads((tmp_path / "as_built.json").read_text())
+    assert [m["values"] for m in written["ensemble"]] == [m["values"] for m in kept["ensemble"]]  # 11, as kept
+    assert written["bounds"] == kept["bounds"] and written["bounds"]["air_fraction"]["high"] == 0.08
+    assert written["made_by"].startswith(kept["made_by"].split(";")[0]) and "air_fraction" in written["made_by"]
+    assert calibrate.FITTED != trial.trial_box() and "air_fraction" not in calibrate.PROFILED  # put back
+
+
+def test_the_ninth_refit_kept_for_the_trials_is_the_preset_the_docs_quote_them_on():
+    from twin.plants import as_built
+
+    # 57ff10bf5b36: the stamp of the pages that quote these trials (tests/test_docs.py), the committed preset
+    # from 2026-11-26; the trials that ran on it read this copy, so a refit does not change what they print.
+    assert as_built.preset_digest(ROOT / "examples" / "ninth_refit.json") == "57ff10bf5b36"
+
+
+def test_prediction_md_quotes_the_trial_air_box_prediction_as_registered():
+    import csv
+
+    text = (ROOT / "docs" / "prediction.md").read_text(encoding="utf-8")
+    section = text[text.index("## Beside it: T3 on a trial refit"):]
+    section = section[:section.index("\n## ")]
+    labels = {"FF + PVA": "ffpva", "sliding mode": "smc"}
+    quoted = {}
+    for line in section.splitlines():
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if len(cells) == 9 and cells[0] in labels:
+            quoted[labels[cells[0]], float(cells[1].split()[0]), cells[2]] = cells[3:9]
+    folder = ROOT / "examples" / "trial_air_box"
+    with open(folder / "prediction.csv", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    members: dict[tuple, list[float]] = {}
+    with open(folder / "prediction_members.csv", encoding="utf-8") as handle:
+        for m in csv.DictReader(handle):
+            members.setdefault((m["controller"], float(m["payload_g"]), m["orientation"]), []).append(float(m["twin_mean"]))
+    assert len(rows) == len(quoted) == 12 and {len(v) for v in members.values()} == {11}
+    for r in rows:
+        key = (r["controller"], float(r["payload_g"]), r["orientation"])
+        wanted = [f"{float(r[k]):.2f}" for k in ("twin_mean", "band_p10", "band_p50", "band_p90")]
+        wanted += [f"{min(members[key]):.2f}-{max(members[key]):.2f}", r["stalled_runs"]]
+        assert quoted[key] == wanted, key
