@@ -29,7 +29,8 @@ Nothing is installed: the committed preset and prediction stay as they are. The 
 The result is recorded in docs/prediction.md and docs/calibration-history.md; a slow test in
 tests/experiments/test_trials.py holds the printed numbers.
 
-    python examples/trial_air_box.py [--out DIR] [--calibration FILE [--validate DIR]] [--workers N]
+    python examples/trial_air_box.py [--out DIR] [--calibration FILE] [--workers N]
+    python examples/trial_air_box.py --calibration FILE --validate DIR [--workers N]
 """
 
 from __future__ import annotations

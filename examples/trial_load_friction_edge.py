@@ -5,7 +5,7 @@ The ensemble keeps every evaluated parameter set whose cost on the fit's seeds i
 seed-to-seed noise (the sample std of the best values' cost on four disjoint seed sets, 0.138). The load
 friction's profile points next to the best (0.15 and 0.45 N/N) cost about 0.76, just above that line, so
 the question was whether the line keeps out sets that fit as well. This script asks it three ways, with
-the other fitted values the committed ones:
+the other fitted values the committed ones (the ninth refit's, ``ninth_refit.json``):
 
 1. paired: each load friction's cost on the same four seed sets as the best's (0-9, the fit's, then
    10-19, 20-29, 30-39), and the differences set by set (the same seeds make the runs' noise shared);
