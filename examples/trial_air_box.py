@@ -36,12 +36,11 @@ tests/experiments/test_trials.py holds the printed numbers.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import json
 import pathlib
 import sys
-
-import numpy as np
 
 from twin.batch.tables import write_csv
 from twin.experiments import calibrate
@@ -50,9 +49,10 @@ from twin.experiments.validate import (
     PREDICTION_COLUMNS,
     PREDICTION_MEMBER_COLUMNS,
     SEEDS,
+    member_means,
     prediction_member_rows,
+    prediction_rows,
     rmse_within,
-    stalled_runs,
 )
 
 AIR_TOP = 0.08  # free air per chamber volume at 1 atm: the trial's box top (the committed box: 0.03)
@@ -66,21 +66,29 @@ def trial_box() -> tuple:
                  if f.name == "air_fraction" else f for f in calibrate.FITTED)
 
 
-def run(workers: int) -> tuple[calibrate.Calibration, list[calibrate.Evaluation]]:
-    """The calibration on the trial's box and profiles, and its ensemble of at most :data:`ENSEMBLE_MAX`."""
+@contextlib.contextmanager
+def trial_search():
+    """``calibrate`` searching the trial's box and profiles (:func:`trial_box`, :data:`PROFILED`) inside the block,
+    as it was after it, whatever happens in it."""
     saved = calibrate.FITTED, calibrate.PROFILED
     calibrate.FITTED, calibrate.PROFILED = trial_box(), PROFILED
     try:
-        def progress(done, total, stage, cost, values):
-            shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
-            print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
-
-        result = calibrate.calibrate(workers=workers, progress=progress)
-        best = next(e for e in result.history if e.values == result.values)
-        ensemble = calibrate.choose_ensemble(result.history, best, result.noise, limit=ENSEMBLE_MAX)
-        return dataclasses.replace(result, ensemble=ensemble), ensemble
+        yield
     finally:
         calibrate.FITTED, calibrate.PROFILED = saved
+
+
+def run(workers: int) -> calibrate.Calibration:
+    """The calibration on the trial's box and profiles, with its ensemble of at most :data:`ENSEMBLE_MAX`."""
+    def progress(done, total, stage, cost, values):
+        shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
+        print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
+
+    with trial_search():  # the ensemble too: its extremes are of the trial's profiled parameters, on its box
+        result = calibrate.calibrate(workers=workers, progress=progress)
+        best = next(e for e in result.history if e.values == result.values)
+        return dataclasses.replace(result, ensemble=calibrate.choose_ensemble(result.history, best, result.noise,
+                                                                              limit=ENSEMBLE_MAX))
 
 
 def report(data: dict, workers: int, out: pathlib.Path | None = None) -> None:
@@ -95,28 +103,22 @@ def report(data: dict, workers: int, out: pathlib.Path | None = None) -> None:
     within = sum(rmse_within(r["twin_rmse_deg"], r["experiment_rmse_deg"]) for r in checked)
     print(f"measured cells within 20 % on seeds {data['check_seeds'][0]}-{data['check_seeds'][-1]} (best): "
           f"{within} of {len(checked)}")
-    members = [m["values"] for m in data["ensemble"]]
     print("members: " + "; ".join(f"{m['cost']:.3f} ({m['stage']}) air {m['values']['air_fraction'] * 100:.2f} %, "
                                   f"breakaway {m['values']['stiction']:.2f} N, load {m['values']['load_friction']:.2f}, "
                                   f"CCW {m['values']['ccw_coulomb_scale']:.3f}, K_OB {m['values']['observer_gain']:.0f}"
                                   for m in data["ensemble"]))
     with calibrate.Evaluator(seeds=SEEDS, workers=workers) as evaluator:
-        per_member = [evaluator.cells(values, keys=PREDICTION_CELLS) for values in members]
+        per_member = [evaluator.cells(m["values"], keys=PREDICTION_CELLS) for m in data["ensemble"]]
+    rows = prediction_rows(per_member, per_member[0])  # the best is the first member
+    detail = {"per_member": [[c.mean_rmse for c in m] for m in per_member]}
+    means = member_means(detail)  # (cells, members)
     print("T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs")
-    rows = []
-    for k, key in enumerate(PREDICTION_CELLS):
-        means = [m[k].mean_rmse for m in per_member]
-        p10, p50, p90 = (float(np.percentile(means, q)) for q in (10, 50, 90))
-        stalled = sum(stalled_runs(m[k]) for m in per_member)
-        rows.append({"controller": key[0], "trajectory": key[1], "payload_g": key[2], "orientation": key[3],
-                     "twin_mean": means[0], "band_p10": p10, "band_p50": p50, "band_p90": p90,
-                     "stalled_runs": stalled})
-        print(f"  {key[0]:6} {key[2]:4g} g {key[3]:10} {means[0]:.2f}  {p10:.2f}-{p90:.2f}  "
-              f"{min(means):.2f}-{max(means):.2f}  {stalled}")
+    for r, cell in zip(rows, means, strict=True):
+        print(f"  {r['controller']:6} {r['payload_g']:4g} g {r['orientation']:10} {r['twin_mean']:.2f}  "
+              f"{r['band_p10']:.2f}-{r['band_p90']:.2f}  {cell.min():.2f}-{cell.max():.2f}  {r['stalled_runs']}")
     if out is not None:
         out.mkdir(parents=True, exist_ok=True)
         write_csv(rows, PREDICTION_COLUMNS, out / "prediction.csv")
-        detail = {"per_member": [[c.mean_rmse for c in m] for m in per_member]}
         write_csv(prediction_member_rows(rows, detail), PREDICTION_MEMBER_COLUMNS, out / "prediction_members.csv")
         print(f"wrote {out / 'prediction.csv'} and {out / 'prediction_members.csv'}")
     print("which law leads, per member (cells H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g): S sliding mode, F FF + PVA")
@@ -127,39 +129,35 @@ def report(data: dict, workers: int, out: pathlib.Path | None = None) -> None:
         print(f"  air {member['values']['air_fraction'] * 100:5.2f} %  cost {member['cost']:.3f}  {lead}")
 
 
-def validate_on(calibration: pathlib.Path, out: pathlib.Path, workers: int) -> int:
-    """``twin validate --out OUT`` with the trial's ``calibration`` file in place of the committed preset (and the
-    trial's box, which its values must lie in); the committed preset is untouched, and put back after.
-
-    Every reader of the preset is pointed at ``calibration`` (one given the committed file's path too, as
-    ``preset_digest`` and ``ensemble_plants`` pass it on), and the plant registry's cached ``as-built`` plants
-    are set aside (``as-built`` is set to the trial's plant: a test may have left it cached with no lazy entry), so
-    that the plants `twin validate` looks up by name are the trial's; they are dropped and the cached ones put back
-    after."""
-    from twin.cli import main as twin_main
+@contextlib.contextmanager
+def trial_preset(calibration: pathlib.Path):
+    """The trial's ``calibration`` file as the as-built preset inside the block (and the trial's box, which its
+    values must lie in): every reader of the preset asks :data:`twin.plants.as_built.CALIBRATION_FILE`, and the plant
+    registry's cached ``as-built`` plants are set aside (``as-built`` set to the trial's: a test may have left it
+    cached with no lazy entry); after the block, the committed file and the cached plants again."""
     from twin.plants import ENSEMBLE_PREFIX, PLANTS, as_built
 
-    def pointed(read):
-        def on_trial(path: pathlib.Path = as_built.CALIBRATION_FILE):
-            return read(calibration if path == as_built.CALIBRATION_FILE else path)
-        return on_trial
-
-    names = ("FITTED", "calibrated_values", "ensemble_values", "calibration_cost_line")
-    saved = {name: getattr(as_built, name) for name in names}
+    saved = as_built.CALIBRATION_FILE, as_built.FITTED
     cached = dict(PLANTS._plants)  # the registry's loaded plants (private: a trial script, not the package)
     try:
+        as_built.CALIBRATION_FILE, as_built.FITTED = calibration, trial_box()
         for name in [n for n in PLANTS._plants if n.startswith(ENSEMBLE_PREFIX)]:
             del PLANTS._plants[name]  # members are built again on asking, from the trial's file
-        as_built.FITTED = trial_box()
-        for name in names[1:]:
-            setattr(as_built, name, pointed(saved[name]))
         PLANTS._plants["as-built"] = as_built.as_built_plant()  # the trial's, in place of any cached one
-        return twin_main(["validate", "--out", str(out), "--workers", str(workers)])
+        yield
     finally:
-        for name, value in saved.items():
-            setattr(as_built, name, value)
+        as_built.CALIBRATION_FILE, as_built.FITTED = saved
         PLANTS._plants.clear()
         PLANTS._plants.update(cached)
+
+
+def validate_on(calibration: pathlib.Path, out: pathlib.Path, workers: int) -> int:
+    """``twin validate --out OUT`` with the trial's ``calibration`` file in place of the committed preset
+    (:func:`trial_preset`); the committed preset is untouched."""
+    from twin.cli import main as twin_main
+
+    with trial_preset(calibration):
+        return twin_main(["validate", "--out", str(out), "--workers", str(workers)])
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -179,13 +177,9 @@ def main(argv: list[str] | None = None) -> None:
     if args.calibration:
         data = json.loads(args.calibration.read_text())
     else:
-        result, _ = run(args.workers)
-        saved = calibrate.FITTED, calibrate.PROFILED
-        calibrate.FITTED, calibrate.PROFILED = trial_box(), PROFILED  # the file's bounds and method are the trial's
-        try:
+        result = run(args.workers)
+        with trial_search():  # the file's bounds and method are the trial's
             data = calibrate.record(result)
-        finally:
-            calibrate.FITTED, calibrate.PROFILED = saved
         print(f"the fit: {result.wall_time:.0f} s")
         if args.out:
             args.out.mkdir(parents=True, exist_ok=True)

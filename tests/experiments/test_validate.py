@@ -124,9 +124,7 @@ def test_validate_without_a_calibration_is_a_one_line_error_and_writes_nothing(t
     from twin.cli import main
     from twin.plants import as_built
 
-    monkeypatch.setattr(as_built, "CALIBRATION_FILE", tmp_path / "missing.json")
-    monkeypatch.setattr(as_built.calibrated_values, "__defaults__", (tmp_path / "missing.json",))
-    monkeypatch.setattr(as_built.ensemble_values, "__defaults__", (tmp_path / "missing.json",))
+    monkeypatch.setattr(as_built, "CALIBRATION_FILE", tmp_path / "missing.json")  # every reader asks for it
     assert main(["validate", "--out", str(tmp_path / "v")]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("twin: error: cannot read the as-built calibration")

@@ -677,6 +677,19 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     experiment = [[c for c in m if c.key in calibrate.EXPERIMENT_CELLS] for m in fitted]
     own = next((cells for values, cells in zip(members, per_member, strict=True) if values == committed), None)
     own = own or evaluator.cells(committed, keys=PREDICTION_CELLS)
+    rows = prediction_rows(per_member, own)
+    detail = {"members": members, "runs": len(members) * len(SEEDS),
+              "per_member": [[c.mean_rmse for c in m] for m in per_member],
+              "orders": [_known_orders(m) for m in experiment],
+              "fitted_means": [{c.key: c.mean_rmse for c in m} for m in fitted]}
+    return rows, own, detail
+
+
+def prediction_rows(per_member: Sequence[Sequence[calibrate.CellResult]],
+                    own: Sequence[calibrate.CellResult]) -> list[dict]:
+    """``prediction.csv``'s rows (:data:`PREDICTION_COLUMNS`): per T3 cell, ``own``'s mean (the committed
+    preset's), the 10/50/90 % percentiles of the members' means and the members' stalled runs; ``per_member`` and
+    ``own`` hold the cells of :data:`PREDICTION_CELLS` in order."""
     rows = []
     for k, key in enumerate(PREDICTION_CELLS):
         means = [m[k].mean_rmse for m in per_member]
@@ -684,11 +697,7 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
         rows.append({"controller": key[0], "trajectory": key[1], "payload_g": key[2], "orientation": key[3],
                      "twin_mean": own[k].mean_rmse, "band_p10": p10, "band_p50": p50, "band_p90": p90,
                      "stalled_runs": sum(stalled_runs(m[k]) for m in per_member)})
-    detail = {"members": members, "runs": len(members) * len(SEEDS),
-              "per_member": [[c.mean_rmse for c in m] for m in per_member],
-              "orders": [_known_orders(m) for m in experiment],
-              "fitted_means": [{c.key: c.mean_rmse for c in m} for m in fitted]}
-    return rows, own, detail
+    return rows
 
 
 def _why_members(v: Validation) -> list[str]:

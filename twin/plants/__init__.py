@@ -114,7 +114,7 @@ class PlantRegistry(MutableMapping):
         return repr(loaded)
 
 
-PLANTS = PlantRegistry(THESIS_PLANTS, {"as-built": (as_built.CALIBRATION_FILE.exists, as_built.as_built_plant)})
+PLANTS = PlantRegistry(THESIS_PLANTS, {"as-built": (lambda: as_built.CALIBRATION_FILE.exists(), as_built.as_built_plant)})
 
 
 def plant(name: str) -> Plant:

@@ -144,6 +144,12 @@ ASSUMED = {
 }
 
 
+def _file(path: pathlib.Path | None) -> pathlib.Path:
+    """``path``, or the committed calibration (:data:`CALIBRATION_FILE` as it is when asked, so a test or a trial
+    that sets it points every reader below at another file)."""
+    return CALIBRATION_FILE if path is None else path
+
+
 def _record(path: pathlib.Path) -> dict:
     try:
         return json.loads(path.read_text())
@@ -164,24 +170,27 @@ def _checked(values: object, path: pathlib.Path, what: str) -> dict[str, float]:
     return out
 
 
-def calibrated_values(path: pathlib.Path = CALIBRATION_FILE) -> dict[str, float]:
+def calibrated_values(path: pathlib.Path | None = None) -> dict[str, float]:
     """The fitted values from ``path`` (the committed calibration by default)."""
+    path = _file(path)
     return _checked(_record(path).get("fitted"), path, "fitted values")
 
 
-def ensemble_values(path: pathlib.Path = CALIBRATION_FILE) -> list[dict[str, float]]:
+def ensemble_values(path: pathlib.Path | None = None) -> list[dict[str, float]]:
     """The calibration ensemble from ``path``: the parameter sets that fit the measurements about as
     well as the fitted one (within the seed-to-seed noise of the best cost; ``twin calibrate``), the
     fitted one first. A file without an ensemble gives the fitted values alone."""
+    path = _file(path)
     record = _record(path)
     members = record.get("ensemble") or [{"values": record.get("fitted")}]
     return [_checked(m.get("values") if isinstance(m, dict) else None, path, f"ensemble member {k}")
             for k, m in enumerate(members)]
 
 
-def calibration_cost_line(path: pathlib.Path = CALIBRATION_FILE) -> tuple[float, float]:
+def calibration_cost_line(path: pathlib.Path | None = None) -> tuple[float, float]:
     """The fitted values' cost and its seed-to-seed noise from ``path``: ``twin calibrate`` drew its ensemble
     from every evaluated set with cost <= cost + noise."""
+    path = _file(path)
     record = _record(path)
     try:
         best, noise = float(record["cost"]), float(record["noise"]["std"])
@@ -238,13 +247,13 @@ def as_built_plant(values: dict[str, float] | None = None, *, without: Iterable[
                  metrics_on_sensor=options["metrics_on_sensor"])
 
 
-def ensemble_plants(path: pathlib.Path = CALIBRATION_FILE) -> list:
+def ensemble_plants(path: pathlib.Path | None = None) -> list:
     """One :class:`twin.plants.Plant` per calibration ensemble member, named ``as-built~K`` (K from 0,
     the fitted preset's values first)."""
     return [as_built_plant(values, name=f"as-built~{k}") for k, values in enumerate(ensemble_values(path))]
 
 
-def preset_digest(path: pathlib.Path = CALIBRATION_FILE) -> str:
+def preset_digest(path: pathlib.Path | None = None) -> str:
     """12 hex digits naming the as-built plant and its ensemble as they load from ``path``: every one of
     their parameters, fitted, assumed or the thesis's. It does not see the controllers' gains (the plant
     names only its gain set), the trajectories or the code. The README and the pages in docs/ that quote
