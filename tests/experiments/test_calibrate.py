@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -99,7 +100,7 @@ def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_each_prof
         return {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14,
                 "load_friction": load, "observer_gain": 100.0}
 
-    assert calibrate.PROFILED == ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale")
+    assert calibrate.PROFILED == ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale", "air_fraction")
     history = [E(v(2.0), 1.00, "scan"), E(v(1.2), 1.04, "profile"), E(v(2.4), 1.05, "profile"),
                E(v(1.8), 1.02, "simplex"), E(v(1.8), 1.02, "simplex"), E(v(2.5), 1.30, "profile"),
                E(v(1.9, 0.02), 1.01, "simplex")]
@@ -156,6 +157,17 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
     assert [m["stiction"] for m in ensemble_values(path)] == [values["stiction"], FITTED[0].low]
     plot_calibration(data, tmp_path / "c.png")
     assert (tmp_path / "c.png").stat().st_size > 0
+
+
+def test_the_second_start_is_the_ninth_refit_inside_the_box_and_one_outside_is_refused():
+    ninth = json.loads((pathlib.Path(__file__).parents[2] / "examples" / "ninth_refit.json").read_text())
+    assert calibrate.PREVIOUS_FITS == (ninth["fitted"],)  # to the last bit
+    box = {f.name: f for f in FITTED}
+    assert all(box[n].low <= v <= box[n].high for n, v in ninth["fitted"].items())
+    assert box["air_fraction"].high == 0.08 and ninth["bounds"]["air_fraction"]["high"] == 0.03
+    outside = dict(ninth["fitted"], air_fraction=0.09)
+    with pytest.raises(ValueError, match="air_fraction lies outside the box"):
+        calibrate.calibrate(workers=1, previous=[outside])
 
 
 def test_unit_box_maps_onto_the_plausible_bounds():
@@ -264,8 +276,10 @@ def test_same_seeds_same_fit_whatever_the_workers():
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    # two points along each profiled parameter (the load friction, the breakaway, the observer gain, the CCW scale)
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 8
+    # two points along each profiled parameter (the load friction, the breakaway, the observer gain, the CCW scale,
+    # the air), then the second start, evaluated at exactly its values
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 10 + ["previous"]
+    assert one.history[-1].values == calibrate.PREVIOUS_FITS[0] and one.evaluations == 14
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)
@@ -283,7 +297,7 @@ def test_calibrate_retraces_the_committed_fit():
     the model or the cost moves it by far more); the values stay exact."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     result = calibrate.calibrate(workers=2, scan_points=0, simplex_evaluations=0, profile_points=0,
-                                 noise_seed_sets=(), check_seeds=())
+                                 noise_seed_sets=(), check_seeds=(), previous=())
     (first,) = result.history
     assert first.values == committed["history"][0]["values"]
     assert first.cost == pytest.approx(committed["history"][0]["cost"], rel=1e-12, abs=0.0)

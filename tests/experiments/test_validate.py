@@ -12,9 +12,11 @@ import sys
 import numpy as np
 import pytest
 
-from twin.experiments import score, validate
+from twin.experiments import calibrate, score, validate
 from twin.experiments.reference import THESIS_PAYLOADS_G
 from twin.plants.as_built import ensemble_values
+
+NINTH_PROFILED = ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale")  # before the air (2026-11-27)
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
 VALIDATION_COLUMNS = ["source", "controller", "trajectory", "payload_g", "orientation", "plant", "measured",
@@ -238,10 +240,11 @@ def test_report_judges_the_dependence_on_every_member_not_the_band_alone():
     assert "| 2.90 | 2.80 | 2.90 | 3.10 | 2.80-4.50 | 0 |" in text
 
 
-def test_report_names_every_parameter_the_members_differ_in_and_only_those_that_set_two_apart():
+def test_report_names_every_parameter_the_members_differ_in_and_only_those_that_set_two_apart(monkeypatch):
     """The spans list each profiled parameter (one value said as such) and any other the members differ in
     (here the leak, which a simplex step moved), not one they share (the air, said apart); the widest cell's two members
     are told apart by what differs between them alone."""
+    monkeypatch.setattr(calibrate, "PROFILED", NINTH_PROFILED)  # the ninth refit's fit, which left the air alone
     base = {"stiction": 1.09, "air_fraction": 0.0283, "ccw_coulomb_scale": 1.16, "leak_conductance": 1.39e-14,
             "load_friction": 0.29, "observer_gain": 340.0}
     members = [base, dict(base, ccw_coulomb_scale=1.27), dict(base, leak_conductance=1.16e-14, load_friction=0.38)]
@@ -982,9 +985,10 @@ def test_a_member_without_a_mean_is_not_counted_out_or_in():
     assert "Out on every member" not in line  # one member has no mean: not known to be out there
 
 
-def test_prediction_names_the_fitted_values_no_member_varies():
+def test_prediction_names_the_fitted_values_no_member_varies(monkeypatch):
     """A fitted value every member shares and the fit does not profile is named, with its unit; the air also
     points to the what-if that moves it; a value that differs between members, or a profiled one, is not."""
+    monkeypatch.setattr(calibrate, "PROFILED", NINTH_PROFILED)  # the ninth refit's fit, which left the air alone
     member = {"stiction": 1.09, "air_fraction": 0.0283, "ccw_coulomb_scale": 1.16, "leak_conductance": 1.39e-14,
               "load_friction": 0.29, "observer_gain": 340.0}
     members = [member, dict(member, leak_conductance=1.5e-14)]

@@ -108,8 +108,10 @@ FITTED = (
            f"breakaway was below P A = {BREAKAWAY_TEST_PRESSURE * THESIS_PARAMS.cylinder.bore_area:.2f} N there; "
            f"the map reaches {STICTION_SCATTER} N above the fitted value, hence P A - {STICTION_SCATTER} N. "
            "Bottom: near eq. 4.5.7's Coulomb level (up to about 2 N)"),
-    Fitted("air_fraction", 0.0, 0.03, "", "free air per chamber volume at 1 atm: none to 3 % (visibly bubbly "
-           "water in 4 mm cylinders and hoses)"),
+    Fitted("air_fraction", 0.0, 0.08, "", "free air per chamber volume at 1 atm: none to 8 %, so that the data, "
+           "not the box, bound it (the thesis says only that trapped air lowers the bulk modulus, §3). Until "
+           "2026-11-27 the top was 3 %, a judgement of visibly bubbly water that bound the fit at 2.83 %; widened "
+           "after a trial found 4-5 % fitting as well (docs/calibration-history.md)"),
     Fitted("ccw_coulomb_scale", 1.0, CCW_SCALE_BOUND, "", "Coulomb friction towards 0 deg relative to eq. "
            "4.5.7, which fits CW and CCW tests together. Top: the same §4.5.1 runs moved the rack at no less than "
            f"0.03 m/s (printed to 0.01: {(SLOWEST_FULL_DUTY_SPEED - FULL_DUTY_SPEED_DIGIT / 2) * 1e3:.0f} mm/s) at "

@@ -1,10 +1,10 @@
 """``twin whatif air``: the blind T3 prediction against the free air in the chambers.
 
-``twin calibrate`` holds the chambers' free air (``air_fraction``) in a box of 0-3 % of the chamber volume, and
-that top is a judgement (visibly bubbly water above it), not a measurement. The fit's profiles do not move the
-air, so every member of the calibration ensemble has the committed value and the prediction's bands cannot show
-what the air does. This what-if runs the committed preset with the air moved and nothing else refitted, and
-gives for each value:
+``twin calibrate`` holds the chambers' free air (``air_fraction``) in a box (0-8 % of the chamber volume since the
+tenth refit; 0-3 % before, a judgement of visibly bubbly water), and since the tenth refit profiles it about the
+best, so the ensemble's members span some air (docs/as-built.md). A profile moves one parameter about the best
+on a few points; this what-if runs the committed preset with the air moved to any values, nothing else
+refitted, and gives for each value:
 
 * the fit's cost on its own seeds (:data:`twin.experiments.calibrate.FIT_SEEDS`) beside the line the
   calibration drew its ensemble with (the best cost plus its seed-to-seed noise, read from the calibration
