@@ -282,15 +282,18 @@ def test_ablation_switches_each_effect_off_once_and_the_line_with_the_chambers()
     assert found == {f"- {e}": ((e, "supply_line") if e == "compressibility" else (e,)) for e in EFFECTS}
 
 
-@pytest.mark.slow  # over ~2.5 s on 2 cores
+@pytest.mark.slow  # about 25 s on 2 cores
 def test_cli_ablation_writes_every_variant_and_cell(tmp_path):
-    proc = twin(tmp_path, "study", "ablation", "--seeds", "1", "--workers", "2", "--out", "ab")
+    # Five runs a cell: a claim about tracking is about the mean. On one run (seed 0, as this test first ran) the
+    # tenth refit's FF + PVA T1 came out 1.35 deg on the averaged valve against 1.29 on the physical one, inside its
+    # run-to-run std of 0.32; on five runs 1.30 against 1.53 (2026-11-27).
+    proc = twin(tmp_path, "study", "ablation", "--seeds", "5", "--workers", "2", "--out", "ab")
     assert proc.returncode == 0, proc.stderr
     _, rows = _rows(tmp_path / "ab" / "ablation.csv")
     assert len(rows) == len(ablation.variants()) * len(EXPERIMENT_CELLS)
     assert (tmp_path / "ab" / "ablation.png").read_bytes().startswith(PNG_MAGIC)
     table = {(r["variant"], r["controller"], int(r["trajectory"])): float(r["twin_rmse_deg"]) for r in rows}
-    evaluator = Evaluator(seeds=(0,), workers=1, cells=EXPERIMENT_CELLS)
+    evaluator = Evaluator(seeds=(0, 1, 2, 3, 4), workers=2, cells=EXPERIMENT_CELLS)
     preset = evaluator.cells(calibrated_values())
     evaluator.close()
     for cell in preset:  # the first row is the committed preset, as calibrate scores it

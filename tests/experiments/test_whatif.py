@@ -339,10 +339,11 @@ def test_whatif_air_scores_as_the_fit_does_and_moves_the_air_alone(tmp_path):
     from twin.experiments.whatifs.ensemble import cell_scenario
     from twin.plants.as_built import as_built_plant, calibrated_values, calibration_cost_line
 
-    rows = _whatif_rows(tmp_path / "air", "air", "--air", "4", "--seeds", "2")
+    # 9 %: outside the fit's box (0-8 % since the tenth refit; until then 4 % was used here, outside 0-3 %)
+    rows = _whatif_rows(tmp_path / "air", "air", "--air", "9", "--seeds", "2")
     committed = calibrated_values()
     best, noise = calibration_cost_line()
-    assert [float(r["air_pct"]) for r in rows[::12]] == [pytest.approx(committed["air_fraction"] * 100, rel=1e-11), 4]
+    assert [float(r["air_pct"]) for r in rows[::12]] == [pytest.approx(committed["air_fraction"] * 100, rel=1e-11), 9]
     assert {r["committed"] for r in rows[:12]} == {"true"} and {r["committed"] for r in rows[12:]} == {"false"}
     assert float(rows[0]["fit_cost"]) == pytest.approx(best, rel=1e-11)
     assert float(rows[0]["cost_line"]) == pytest.approx(best + noise, rel=1e-11)
@@ -350,7 +351,7 @@ def test_whatif_air_scores_as_the_fit_does_and_moves_the_air_alone(tmp_path):
     assert {r["inside_box"] for r in rows[12:]} == {"false"}
     assert (f"air {committed['air_fraction'] * 100:.4g} % (the committed value): cost {best:.3f}, under the line"
             in (tmp_path / "air" / "air.txt").read_text())
-    for k, fraction in enumerate((committed["air_fraction"], 0.04)):
+    for k, fraction in enumerate((committed["air_fraction"], 0.09)):
         plant = as_built_plant({**committed, "air_fraction": fraction})
         plain = run_many([cell_scenario(cell, plant, s) for cell in PREDICTION_CELLS for s in (0, 1)])
         means = [np.mean([math.degrees(r.metrics.rmse) for r in plain[2 * i:2 * i + 2]])

@@ -166,8 +166,9 @@ def experiment_batch(plant, cases: tuple, seeds: tuple) -> dict:
 def weighted_band(values: np.ndarray, weights: np.ndarray) -> float:
     """Width of the weighted 10-90 % band of ``values``: the inverse of the weighted empirical
     distribution (the smallest value whose cumulative weight reaches q), so that a member holding
-    nearly all the weight gives a band of nearly nothing. With equal weights on 8 members it spans
-    them all (1/8 > 10 %)."""
+    nearly all the weight gives a band of nearly nothing. With equal weights on fewer than ten members it
+    spans them all (1/8 > 10 %); on 11 it leaves out the lowest and the highest (1/11 < 10 %), so a refit that
+    weights an extreme up can widen it."""
     order = np.argsort(values)
     v, w = np.asarray(values, dtype=float)[order], np.asarray(weights, dtype=float)[order]
     cdf = np.cumsum(w) / w.sum()
@@ -248,7 +249,7 @@ def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure
 def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_seeds: int, pressure_step: float,
             trials: dict[str, float]) -> str:
     lines = [f"{members} calibration ensemble members, {seeds} virtual rig runs each; Chapter 6 predictions from "
-             f"{prediction_seeds} seeds per member. Band = 10-90 % of the members' mean RMSE (weighted inverse distribution: with equal weights, all members)."]
+             f"{prediction_seeds} seeds per member. Band = 10-90 % of the members' mean RMSE (weighted inverse distribution: with equal weights, all members if fewer than ten, else all but the lowest and the highest)."]
     score = {}
     for name in EXPERIMENTS:
         s = summary[name]
