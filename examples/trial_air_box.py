@@ -1,13 +1,14 @@
-"""Trial (not installed): the calibration with the chambers' free air let out of its 3 % box and profiled.
+"""Trial: the calibration with the chambers' free air let out of its 3 % box and profiled (2026-11-27).
 
-``twin calibrate`` holds the free air (``air_fraction``, free air per chamber volume at 1 atm) in 0-3 %, a
-judgement (visibly bubbly water above it), not a bound from the text: the thesis says only that trapped air
-lowers the bulk modulus (§3). It never profiles the air, so every ensemble member has the committed 2.83 %
-and the T3 prediction's bands cannot show what the air does, although `twin whatif air` found 4 and 5 % fitting
-about as well and turning which law leads on T3 (docs/prediction.md).
+Written when ``twin calibrate`` (up to the ninth refit) held the free air (``air_fraction``, free air per chamber
+volume at 1 atm) in 0-3 %, a judgement (visibly bubbly water above it), not a bound from the text: the thesis
+says only that trapped air lowers the bulk modulus (§3). It did not profile the air, so every ensemble member had
+the then committed 2.83 % and the T3 prediction's bands could not show what the air does, although `twin whatif
+air` had found 4 and 5 % fitting about as well and turning which law leads on T3 (docs/prediction.md). The
+tenth refit, later that day, took this script's box and profile into ``twin calibrate``.
 
-This script runs the same search as ``twin calibrate`` (scan, simplex, noise, profiles, ensemble; the same
-seeds and budgets) with two changes, fixed before it was first run:
+This script runs the same search as the ninth refit's ``twin calibrate`` (scan, simplex, noise, profiles,
+ensemble; the same seeds and budgets; no second start) with two changes, fixed before it was first run:
 
 * the air's box is 0-8 %: wide enough that the data, not the box, bound it (in
   ``examples/trial_chamber_buildup.py`` the committed values cost, set by set, 0.65 more at 1 % and 0.21 more at

@@ -168,6 +168,26 @@ def test_the_second_start_is_the_ninth_refit_inside_the_box_and_one_outside_is_r
     outside = dict(ninth["fitted"], air_fraction=0.09)
     with pytest.raises(ValueError, match="air_fraction lies outside the box"):
         calibrate.calibrate(workers=1, previous=[outside])
+    short = {k: v for k, v in ninth["fitted"].items() if k != "leak_conductance"}
+    with pytest.raises(ValueError, match="exactly the fitted parameters"):
+        calibrate.calibrate(workers=1, previous=[short])
+    with pytest.raises(ValueError, match="exactly the fitted parameters"):
+        calibrate.calibrate(workers=1, previous=[dict(ninth["fitted"], extra=1.0)])
+
+
+def test_the_committed_file_holds_the_second_start_as_evaluated_and_as_a_member():
+    """The tenth refit's file: its last history row is the second start at exactly the ninth refit's values,
+    costing what the ninth refit's file says (to 1e-12: machines differ in the last bits), more than the best;
+    it is the ensemble's second member, and made_by says so."""
+    committed = json.loads(CALIBRATION_FILE.read_text())
+    ninth = json.loads((pathlib.Path(__file__).parents[2] / "examples" / "ninth_refit.json").read_text())
+    last = committed["history"][-1]
+    assert last["stage"] == "previous" and last["values"] == ninth["fitted"]
+    assert [h["stage"] for h in committed["history"]].count("previous") == 1
+    assert last["cost"] == pytest.approx(ninth["cost"], rel=1e-12) and last["cost"] > committed["cost"]
+    assert last["cost"] <= committed["cost"] + committed["noise"]["std"]  # within the noise: a member by the rule
+    assert committed["ensemble"][1] == last and committed["version"] == calibrate.FILE_VERSION == 8
+    assert "second start" in committed["made_by"]
 
 
 def test_unit_box_maps_onto_the_plausible_bounds():

@@ -195,8 +195,9 @@ def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_sa
     assert "The controller order, wrong on 1 of 2 Chapter 5 trajectories (T2: follows from the cells that miss)" in short
     assert "The open-loop lag at reversals, out on 1 of 1." in short and "steady-error" not in short
     assert ("- **Blind T3 prediction** (6 cells): FF + PVA tracks best on 2 of 3 payload and side cells, sliding "
-            "mode tracks best on 1 of 3 payload and side cells (the committed preset); 3 runs of the ensemble's "
-            "members stall.") in short
+            "mode tracks best on 1 of 3 payload and side cells (the committed preset); across the ensemble, 2 members: "
+            "FF + PVA ahead in 2 of 3, sliding mode ahead in 1 of 3; 3 runs of the ensemble's members stall.") in short
+    assert "turns on which of the equally good fits holds" not in text  # the members agree
     within = validate.report(_fake(1.0, lag_within=True, stalled=0))
     assert "of the vertical cells with a payload, 1 of 1 RMSE means" in within
     assert "open-loop" not in within.split("## Summary")[0] and "The valve" not in within.split("## Summary")[0]
@@ -209,7 +210,7 @@ def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_sa
             "side cells") in short
     for r, n in zip(v.prediction, (0, 1, 0, 0, 0, 0), strict=True):
         r["stalled_runs"] = n
-    assert "(the committed preset); 1 run of the ensemble's members stalls." in validate.report(v)
+    assert "sliding mode ahead in 1 of 3; 1 run of the ensemble's members stalls." in validate.report(v)
     # Only misses on the verdict's seeds 0-4 are listed (sliding mode T1 flat misses on seeds 40-49 only, each
     # steady-error range with its reading; a failed mean is said as failed.
     v, missed, text = _miss_report()
@@ -258,6 +259,39 @@ def test_report_names_every_parameter_the_members_differ_in_and_only_those_that_
     assert "air" not in listing and "CCW Coulomb scale: 1.16, 1.27, 1.16" in listing
     assert text.count("Every member has the same") == 1  # said apart, once
     assert "Every member has the same air 2.83 %: the fit does not profile it" in text
+
+
+def test_report_says_when_the_members_disagree_on_which_law_leads_on_t3_and_which_member_it_is():
+    """Two members with FF + PVA ahead in 2 of 3 cells, one with sliding mode ahead in all three: the opening line
+    groups them, and a bullet names the member set apart with its values (the band would leave it out)."""
+    base = {"stiction": 1.79, "air_fraction": 0.046, "ccw_coulomb_scale": 1.15, "leak_conductance": 1.5e-14,
+            "load_friction": 0.30, "observer_gain": 515.0}
+    members = [base, dict(base, stiction=1.09, air_fraction=0.0283), dict(base, observer_gain=500.0)]
+    # per member, the cells in the fake's prediction order: ffpva 0 g, smc 0 g, ffpva 6.5, smc 6.5, ffpva 13.5, smc 13.5
+    per_member = [[2.0, 2.2, 2.4, 2.6, 3.5, 3.4], [2.3, 2.2, 2.7, 2.6, 3.6, 3.4], [2.0, 2.1, 2.4, 2.5, 3.5, 3.6]]
+    v = _fake(1.0, lag_within=True, stalled=0, members=members, per_member=per_member)
+    v.prediction = [dict(v.prediction[0], controller=c, payload_g=g, twin_mean=x)
+                    for c, g, x in (("ffpva", 0.0, 2.0), ("smc", 0.0, 2.2), ("ffpva", 6.5, 2.4), ("smc", 6.5, 2.6),
+                                    ("ffpva", 13.5, 3.5), ("smc", 13.5, 3.4))]
+    assert validate.member_leads(v.prediction, v.prediction_detail) == [{"ffpva": 2, "smc": 1}, {"smc": 3},
+                                                                       {"ffpva": 3}]
+    text = validate.report(v)
+    short = text[text.index("## In short"):text.index("## Summary")]
+    assert ("across the ensemble, 1 member: FF + PVA ahead in 2 of 3, sliding mode ahead in 1 of 3; 1 member: "
+            "sliding mode ahead in 3 of 3; 1 member: FF + PVA ahead in 3 of 3") in short
+    assert ("- **Which law leads on T3 turns on which of the equally good fits holds**: on the ensemble's 3 members, "
+            in text)
+    assert "Set apart: member 1 (" in text and "breakaway 1.09 N" in text.split("Set apart: member 1 (")[1][:400]
+    assert "the 10-90 % band leaves a lone member out" in text
+
+
+def test_band_ends_are_said_as_members_or_interpolated_by_the_count():
+    assert validate._band_ends_text(11) == "with 11 members its ends are the second-lowest and the second-highest member's means"
+    assert validate._band_ends_text(21) == "with 21 members its ends are the third-lowest and the third-highest member's means"
+    assert validate._band_ends_text(9) == "with 9 members its ends are interpolated between neighbouring members"
+    import numpy as np  # the claim itself: numpy's 10 % of 11 values is the second-lowest
+
+    assert np.percentile(np.arange(11.0) ** 2, 10) == 1.0 and np.percentile(np.arange(9.0) ** 2, 10) != 1.0
 
 
 def test_report_shows_what_sliding_modes_switching_term_does():

@@ -372,6 +372,9 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
     """Fit :data:`twin.plants.as_built.FITTED` (see the module docstring). ``previous``: the second start's
     values (each must lie in the box). ``progress(done, total, stage, cost, values)`` after each evaluation."""
     for values in previous:
+        if set(values) != {f.name for f in FITTED}:
+            raise ValueError(f"a second start must give exactly the fitted parameters {[f.name for f in FITTED]}, "
+                             f"not {sorted(values)}")
         outside = [f.name for f in FITTED if not f.low <= values[f.name] <= f.high]
         if outside:
             raise ValueError(f"a second start's {', '.join(outside)} lies outside the box")
@@ -438,6 +441,9 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
         stage = "previous"
         for values in previous:  # evaluated as given (the unit box's round trip would move their last bits)
             objective(unit_of(values), {f.name: values[f.name] for f in FITTED})
+        # After the noise and the profiles: if a second start ever cost less than the best, it would become the
+        # fitted values below without profiles of its own, and the noise would be the other point's (on the tenth
+        # refit it costs more: 0.5587 against 0.5367).
         # A profile point may beat the simplex (the cost is flat along the breakaway, within the noise):
         # the fitted values are the lowest cost evaluated.
         best, fit_cells = seen[lowest()]
@@ -474,7 +480,9 @@ def record(result: Calibration) -> dict:
         "code_version": code_version(),
         "made_by": f"twin calibrate (Sobol scan of {SCAN_POINTS} + centre, Nelder-Mead, profiles of "
                    f"{' and '.join(PROFILED)}; "
-                   f"{result.evaluations} evaluations on fit seeds {list(result.fit_seeds)})",
+                   + (f"a second start from the ninth refit's values ({starts}, stage 'previous'); "
+                      if (starts := sum(e.stage == "previous" for e in result.history)) else "")
+                   + f"{result.evaluations} evaluations on fit seeds {list(result.fit_seeds)})",
         "loss": f"Cauchy, scale ln 1.2 = {LOSS_SCALE:.4f}; SSE-range residuals weighted sqrt({SSE_WEIGHT})",
         "targets": [dataclasses.asdict(t) for t in TARGETS],
         "fitted": dict(result.values),  # full precision: the preset is exactly what was scored

@@ -771,6 +771,46 @@ def _members_right_text(detail: dict, t: int, right: Sequence[int]) -> str:
     return text
 
 
+def member_leads(prediction: Sequence[dict], detail: dict) -> list[dict[str, int]]:
+    """Per ensemble member, in how many of the T3 payload and side cells each controller has the lower mean
+    (a cell where a mean is not a number is left out; a tie counts for neither)."""
+    means = member_means(detail)
+    cells: dict[tuple, dict[str, int]] = {}
+    for i, r in enumerate(prediction):
+        cells.setdefault((r["payload_g"], r["orientation"]), {})[r["controller"]] = i
+    leads = []
+    for m in range(means.shape[1]):
+        count: dict[str, int] = {}
+        for pair in cells.values():
+            values = {c: float(means[i, m]) for c, i in pair.items() if math.isfinite(means[i, m])}
+            if len(values) == 2 and len(set(values.values())) == 2:
+                best = min(values, key=values.get)
+                count[best] = count.get(best, 0) + 1
+        leads.append(count)
+    return leads
+
+
+def _leads_text(count: dict[str, int], cells: int) -> str:
+    """"sliding mode ahead in 6 of 6" (the controller ahead in more cells first), from one member's leads."""
+    ranked = sorted(count.items(), key=lambda cn: (-cn[1], cn[0]))
+    return ", ".join(f"{CONTROLLER_LABELS[c]} ahead in {n} of {cells}" for c, n in ranked) or "no lead"
+
+
+def _members_lead_text(v: Validation) -> tuple[str, list[int]]:
+    """The T3 leads over the ensemble's members, grouped ("10 members: sliding mode ahead in 6 of 6; 1 member:
+    FF + PVA ahead in 5 of 6, sliding mode ahead in 1 of 6"), and the members whose majority law differs from
+    most members' (empty if they all agree)."""
+    leads = member_leads(v.prediction, v.prediction_detail)
+    cells = len({(r["payload_g"], r["orientation"]) for r in v.prediction})
+    groups: dict[str, list[int]] = {}
+    for m, count in enumerate(leads):
+        groups.setdefault(_leads_text(count, cells), []).append(m)
+    text = "; ".join(f"{counted(len(ms), 'member')}: {t}" for t, ms in sorted(groups.items(), key=lambda g: -len(g[1])))
+    majority = [max(count, key=count.get) if count else None for count in leads]
+    usual = max(sorted(set(majority), key=str), key=majority.count)  # sorted: the same pick on every run
+    return text, [m for m, c in enumerate(majority) if c != usual]
+
+
 def member_means(detail: dict) -> np.ndarray:
     """Each ensemble member's five-run mean RMSE per T3 cell, (cells, members), from ``prediction``'s
     detail."""
@@ -1439,11 +1479,18 @@ def _why(v: Validation) -> list[str]:
                  f"{widest['orientation']}: its members' means span {means[k].min():.2f}-{means[k].max():.2f} deg "
                  f"({relative:.0%} of the median; 10-90 % band {widest['band_p10']:.2f}-{widest['band_p90']:.2f}), "
                  f"from the member with {_member_text(lowest, differ)} to the one with "
-                 f"{_member_text(highest, differ)}. So within what the data allow the T3 prediction "
+                 f"{_member_text(highest, differ)}. So within what the data allow the T3 cells' size "
                  + ("does not turn on them" if relative < RMSE_TOLERANCE else "**turns on them** there: read the "
                     "members' range, not the committed value")
                  + (" (no run of any member stalls)." if not any(r["stalled_runs"] for r in v.prediction) else
                     "; some members' runs stall, counted per cell above."))
+    text, apart = _members_lead_text(v)
+    if apart:
+        lines.append(f"- **Which law leads on T3 turns on which of the equally good fits holds**: on the ensemble's "
+                     f"{len(members)} members, {text}. Set apart: "
+                     + "; ".join(f"member {m} ({_member_text(members[m], _profiled(members))})" for m in apart)
+                     + " (numbered from 0 as in `prediction_members.csv`). Read the members' means there, not the "
+                     "committed preset's lead; the 10-90 % band leaves a lone member out.")
     known = {r["controller"]: r for r in rows if r["source"] == "chapter 5 experiment" and r["trajectory"] == 3
              and r["controller"] in ("ffpva", "smc")}
     if known:
@@ -1452,6 +1499,17 @@ def _why(v: Validation) -> list[str]:
                      "Chapter 5) is off by " + ", ".join(f"{CONTROLLER_LABELS[c]} x{r['ratio']:.2f}" for c, r in known.items())
                      + "; a T3 prediction is as far off as that, at least, before its band.")
     return lines
+
+
+def _band_ends_text(members: int) -> str:
+    """How the 10-90 % band's ends sit among ``members`` means (numpy's linear percentiles)."""
+    if members < 2:
+        return "one member: no spread"
+    if round((members - 1) * 0.1, 9).is_integer():
+        k = round((members - 1) * 0.1)
+        nth = {1: "second", 2: "third", 3: "fourth"}.get(k, f"{k + 1}th")
+        return f"with {members} members its ends are the {nth}-lowest and the {nth}-highest member's means"
+    return f"with {members} members its ends are interpolated between neighbouring members"
 
 
 def _times(ratio) -> str:
@@ -1522,9 +1580,11 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
             best = min(p, key=p.get)
             leads[best] = leads.get(best, 0) + 1
         stalls = sum(r["stalled_runs"] for r in v.prediction)
+        members_text = _members_lead_text(v)[0] if both and v.prediction_detail.get("per_member") else ""
         lines.append(f"- **Blind T3 prediction** ({counted(len(v.prediction), 'cell')}): "
                      + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {len(both)} payload and side cells"
-                                  for c, n in sorted(leads.items())) + " (the committed preset); " if both else "")
+                                  for c, n in sorted(leads.items())) + " (the committed preset)"
+                        + (f"; across the ensemble, {members_text}" if members_text else "") + "; " if both else "")
                      + ("no run of any ensemble member stalls." if not stalls else
                         f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}."))
     return lines
@@ -1753,7 +1813,7 @@ def report(v: Validation) -> str:
     lines += ["## Prediction: Chapter 6 T3 (blind)", "",
               f"The held-back T3 cells, predicted on the committed preset (five runs) and on each of the "
               f"{len(d['members'])} members of the calibration ensemble (five runs each). The band is the 10-90 % "
-              f"range of the members' five-run means (with {len(d['members'])} members its ends are interpolated, so "
+              f"range of the members' five-run means ({_band_ends_text(len(d['members']))}, so "
               "the lowest and the highest member are listed beside it); `stalled` counts the members' runs whose "
               f"error passed {STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). The members, in order: "
               + "; ".join(f"{PARAMETER_TEXT[n][0]}" + (f" ({PARAMETER_TEXT[n][2]})" if PARAMETER_TEXT[n][2] else "")

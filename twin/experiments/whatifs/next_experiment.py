@@ -249,7 +249,7 @@ def next_experiment_study(*, seeds: int = 4, prediction_seeds: int = 3, pressure
 def _answer(summary: dict, hours: dict, *, members: int, seeds: int, prediction_seeds: int, pressure_step: float,
             trials: dict[str, float]) -> str:
     lines = [f"{members} calibration ensemble members, {seeds} virtual rig runs each; Chapter 6 predictions from "
-             f"{prediction_seeds} seeds per member. Band = 10-90 % of the members' mean RMSE (weighted inverse distribution: with equal weights, all members if fewer than ten, else all but the lowest and the highest)."]
+             f"{prediction_seeds} seeds per member. Band = 10-90 % of the members' mean RMSE (weighted inverse distribution: with equal weights, all members if fewer than ten; from ten, not the highest, and from eleven, not the lowest either)."]
     score = {}
     for name in EXPERIMENTS:
         s = summary[name]
