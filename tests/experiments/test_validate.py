@@ -294,6 +294,18 @@ def test_band_ends_are_said_as_members_or_interpolated_by_the_count():
     assert np.percentile(np.arange(11.0) ** 2, 10) == 1.0 and np.percentile(np.arange(9.0) ** 2, 10) != 1.0
 
 
+def test_with_the_air_profiled_the_air_is_spanned_and_never_said_fixed():
+    """Since the tenth refit the fit profiles the air: members sharing it get "(one value)" in the spans, not the
+    sentence that the fit does not profile it; the leak, never profiled, still gets it."""
+    assert "air_fraction" in calibrate.PROFILED
+    member = {"stiction": 1.79, "air_fraction": 0.046, "ccw_coulomb_scale": 1.15, "leak_conductance": 1.5e-14,
+              "load_friction": 0.30, "observer_gain": 515.0}
+    members = [member, dict(member, stiction=1.09)]
+    assert validate._fixed_text(members).startswith("Every member has the same leak 1.50 x 1e-14 m^3/(Pa s): the fit "
+                                                    "does not profile it")
+    assert "air" not in validate._fixed_text(members) and "air 4.60 % (one value)" in validate._spans_text(members)
+
+
 def test_report_shows_what_sliding_modes_switching_term_does():
     v = _fake(1.0, lag_within=True, stalled=0)
     assert "switching term" not in validate.report(v)  # no parts run: no line
