@@ -9,7 +9,7 @@ This script delays the coils' whole signal by ``d`` ticks (1 ms each): the coils
 signal the undelayed loop would give them at tick k - d (the duty in force then, at that tick's place
 in the 16 ms PWM period), and are shut for the first d ticks. The controllers, sensors and hydraulics
 run at tick k as before; only what reaches the coils is late, for all three laws alike (a lag of the
-rig's, not of one law). It runs §8's eleven experimental cells on the ninth refit's as-built preset (``ninth_refit.json``, the committed one when this ran), seeds
+rig's, not of one law). It runs §8's eleven experimental cells on the ninth refit's as-built preset (``twin/plants/data/ninth_refit.json``, the committed one when this ran), seeds
 0-9, for each delay, and prints per cell the mean RMSE, the mean largest error and the ratio to the
 measured mean, then PVA + DZC's T1 error over the move and over the hold, its SSE ranges and how far
 off its runs end. With d = 0 the delayed runs are the plain runs to the last bit; the script checks
@@ -31,7 +31,7 @@ import numpy as np
 
 from twin.envs.runner import run_many
 from twin.physics.valves import ValveBank
-from twin.plants.as_built import as_built_plant, calibrated_values
+from twin.plants.as_built import NINTH_REFIT_FILE, as_built_plant, calibrated_values
 from twin.sim.scenario import Scenario
 
 SEEDS = range(10)
@@ -39,8 +39,7 @@ DELAYS = (0, 1, 2, 3, 4, 5, 6, 8)  # ticks of 1 ms
 CELLS = (("pva", 1), ("pva", 2), ("pva", 3), ("ffpva", 1), ("ffpva", 2), ("ffpva", 3), ("ffpva", 4),
          ("smc", 1), ("smc", 2), ("smc", 3), ("smc", 4))
 PLAIN_UPDATE = ValveBank.update  # the valves as they are
-NINTH_REFIT = pathlib.Path(__file__).with_name("ninth_refit.json")  # the committed preset when this trial ran
-PLANT = as_built_plant(calibrated_values(NINTH_REFIT))
+PLANT = as_built_plant(calibrated_values(NINTH_REFIT_FILE))
 
 
 def lagged(delay: int):
@@ -98,7 +97,6 @@ def main() -> None:
 def _sibling(name: str):
     """Another trial script beside this one, loaded as a module (the examples are not a package)."""
     import importlib.util
-    import pathlib
 
     spec = importlib.util.spec_from_file_location(name, pathlib.Path(__file__).with_name(f"{name}.py"))
     module = importlib.util.module_from_spec(spec)

@@ -8,7 +8,7 @@ moves the joint, so a slower build-up after each closure would let it grow furth
 
 The fit holds the two chamber parameters that set the build-up in a box: free air 0-3 % of the chamber volume
 (the committed value, 2.83 %, sits near the top) and a leak past each discharge valve of 0-3e-14 m^3/(Pa s)
-(committed 1.39e-14). This script runs the committed values (the ninth refit's, ``ninth_refit.json``) with one of the two moved, inside the box and past
+(committed 1.39e-14). This script runs the committed values (the ninth refit's, ``twin/plants/data/ninth_refit.json``) with one of the two moved, inside the box and past
 it, and prints for each:
 
 * the fit's cost on four seed sets (0-9, the fit's, then 10-19, 20-29, 30-39) and the difference from the
@@ -29,26 +29,23 @@ cells, which the README sums up); a slow test in tests/experiments/test_trials.p
 
 from __future__ import annotations
 
-import pathlib
-
 import numpy as np
 
 from twin.experiments import calibrate
 from twin.experiments.reference import THESIS_PAYLOADS_G
 from twin.experiments.studies.openloop import openloop_run
 from twin.experiments.validate import rmse_within
-from twin.plants.as_built import as_built_plant, calibrated_values
+from twin.plants.as_built import NINTH_REFIT_FILE, as_built_plant, calibrated_values
 
 AIR = (0.01, 0.02, 0.025, 0.03, 0.04, 0.05, 0.06, 0.08, 0.12)  # free air per chamber volume at 1 atm; the box is 0-0.03
 LEAK = (0.0, 3e-14, 6e-14, 1.2e-13)  # m^3/(Pa s) past each discharge valve; the box is 0-3e-14
-NINTH_REFIT = pathlib.Path(__file__).with_name("ninth_refit.json")  # the committed preset when this trial ran
 SEED_SETS = (calibrate.FIT_SEEDS, *calibrate.NOISE_SEED_SETS)
 T3 = [(c, 3, g, o) for c in ("ffpva", "smc") for o in ("horizontal", "vertical") for g in THESIS_PAYLOADS_G]
 SHOWN = (("smc", 2), ("smc", 3), ("ffpva", 1))  # printed after PVA T1: (controller, trajectory), 0 g flat
 
 
 def main() -> None:
-    best = calibrated_values(NINTH_REFIT)
+    best = calibrated_values(NINTH_REFIT_FILE)
     points = [("committed", best)]
     points += [(f"air {x:g}", {**best, "air_fraction": x}) for x in AIR]
     points += [(f"leak {x:g}", {**best, "leak_conductance": x}) for x in LEAK]

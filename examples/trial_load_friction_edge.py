@@ -5,7 +5,7 @@ The ensemble keeps every evaluated parameter set whose cost on the fit's seeds i
 seed-to-seed noise (the sample std of the best values' cost on four disjoint seed sets, 0.138). The load
 friction's profile points next to the best (0.15 and 0.45 N/N) cost about 0.76, just above that line, so
 the question was whether the line keeps out sets that fit as well. This script asks it three ways, with
-the other fitted values the committed ones (the ninth refit's, ``ninth_refit.json``):
+the other fitted values the committed ones (the ninth refit's, ``twin/plants/data/ninth_refit.json``):
 
 1. paired: each load friction's cost on the same four seed sets as the best's (0-9, the fit's, then
    10-19, 20-29, 30-39), and the differences set by set (the same seeds make the runs' noise shared);
@@ -22,14 +22,11 @@ Its result (2026-11-26) is in docs/prediction.md.
 from __future__ import annotations
 
 import math
-import pathlib
 
 import numpy as np
 
 from twin.experiments import calibrate
-from twin.plants.as_built import calibrated_values
-
-NINTH_REFIT = pathlib.Path(__file__).with_name("ninth_refit.json")  # the committed preset when this trial ran
+from twin.plants.as_built import NINTH_REFIT_FILE, calibrated_values
 
 LOAD_FRICTIONS = (0.0, 0.15, 0.20, 0.25, 0.35, 0.40, 0.45, 0.60)  # N/N; the box is 0-0.6
 SEED_SETS = (calibrate.FIT_SEEDS, *calibrate.NOISE_SEED_SETS)
@@ -50,7 +47,7 @@ def cost_against(cells: list[calibrate.CellResult], rmse_targets: dict[tuple, fl
 
 
 def main() -> None:
-    best = calibrated_values(NINTH_REFIT)
+    best = calibrated_values(NINTH_REFIT_FILE)
     points = [("committed", best)] + [(f"load {x:.2f}", {**best, "load_friction": x}) for x in LOAD_FRICTIONS]
     all_seeds = tuple(s for seeds in SEED_SETS for s in seeds)
     with calibrate.Evaluator(seeds=all_seeds, workers=2) as evaluator:

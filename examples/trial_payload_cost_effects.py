@@ -3,7 +3,7 @@
 `twin validate` reads the sliding-mode T1 13.5 g horizontal miss by the payload's cost: on seeds 40-79 the
 payload costs the twin's sliding mode x1.20 over its 0 g flat cell, the rig's x1.03, while it costs the
 twin's FF + PVA x1.00, the rig's x1.25 (2026-11-26). This script runs both laws on T1 at 0 g and 13.5 g,
-horizontal, seeds 40-79, on the committed preset (the ninth refit's, ``ninth_refit.json``) as it is and with each effect switched off in turn
+horizontal, seeds 40-79, on the committed preset (the ninth refit's, ``twin/plants/data/ninth_refit.json``) as it is and with each effect switched off in turn
 (compressibility only with the supply line, which needs it), nothing refitted, and prints each cell's mean
 RMSE and the cost (13.5 g over 0 g) with its paired standard error. Its result (2026-11-26) is
 in docs/as-built.md.
@@ -14,15 +14,12 @@ in docs/as-built.md.
 from __future__ import annotations
 
 import math
-import pathlib
 
 import numpy as np
 
 from twin.experiments.calibrate import Evaluator
 from twin.experiments.studies.ablation import variants
-from twin.plants.as_built import calibrated_values
-
-NINTH_REFIT = pathlib.Path(__file__).with_name("ninth_refit.json")  # the committed preset when this trial ran
+from twin.plants.as_built import NINTH_REFIT_FILE, calibrated_values
 
 SEEDS = range(40, 80)
 KEYS = [(c, 1, g, "horizontal") for c in ("ffpva", "smc") for g in (0.0, 13.5)]  # each law's 0 g, then 13.5 g
@@ -39,7 +36,7 @@ def cost(flat: np.ndarray, loaded: np.ndarray) -> tuple[float, float]:
 def main() -> None:
     print("without                          | FF + PVA 0 g, 13.5 g (deg), cost | sliding mode 0 g, 13.5 g (deg), cost "
           "(T1 horizontal, seeds 40-79)")
-    values = calibrated_values(NINTH_REFIT)
+    values = calibrated_values(NINTH_REFIT_FILE)
     with Evaluator(seeds=SEEDS, workers=2, cells=KEYS) as evaluator:
         for _, off in variants():  # the ablation study's: the preset, then each effect off in turn
             if "load_friction" in off:  # it acts only on a vertical joint: this row would be the preset's

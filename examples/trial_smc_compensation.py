@@ -14,7 +14,7 @@ slow motion would differ. This script runs that what-if two ways:
 * ``on the sum``: the compensation applied every 1 ms to u_FF+PVA plus the switching term;
 
 beside the law as the thesis gives it, on the nine cells sliding mode was measured on (§8's T1-T4, §9's
-five T1 payload cells), seeds 0-9, on the committed as-built preset (the ninth refit's, ``ninth_refit.json``), with FF + PVA and PVA + DZC on §8's
+five T1 payload cells), seeds 0-9, on the committed as-built preset (the ninth refit's, ``twin/plants/data/ninth_refit.json``), with FF + PVA and PVA + DZC on §8's
 cells for the controller order. It also runs the six Chapter 6 T3 cells (0 / 6.5 / 13.5 g, horizontal and
 vertical) with both laws, to show what each reading would predict there and which law would lead: a
 what-if beside the blind prediction, which stays as committed. Nothing is refitted. The result is
@@ -26,7 +26,6 @@ recorded in docs/studies-and-whatifs.md.
 from __future__ import annotations
 
 import math
-import pathlib
 
 import numpy as np
 
@@ -37,12 +36,11 @@ from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_PAYLOADS_G, THESIS_ROBUSTNESS_T1_DEG
 from twin.experiments.validate import PREDICTION_CELLS, _order, rmse_within
 from twin.physics.model import Orientation
-from twin.plants.as_built import as_built_plant, calibrated_values
+from twin.plants.as_built import NINTH_REFIT_FILE, as_built_plant, calibrated_values
 from twin.sim.scenario import Scenario
 
 SEEDS = range(10)
-NINTH_REFIT = pathlib.Path(__file__).with_name("ninth_refit.json")  # the committed preset when this trial ran
-PLANT = as_built_plant(calibrated_values(NINTH_REFIT))
+PLANT = as_built_plant(calibrated_values(NINTH_REFIT_FILE))
 BAND = FeedForwardPVAGains(pva=PVAGains()).compensation_band  # %, eq. 5.3.6, FF + PVA's compensation
 # (trajectory, payload g, orientation, measured mean RMSE deg): §8's and §9's sliding mode cells
 SMC_CELLS = (*((t, 0.0, "horizontal", THESIS_EXPERIMENT_RMSE_DEG["smc"][t][0]) for t in (1, 2, 3, 4)),

@@ -7,7 +7,7 @@ friction (eq. 4.5.7, the fitted scale, the stiction map) and the Hall sensor's c
 where the rack is, so a different start puts the move on different friction and a different sensor error.
 
 This script runs all three laws on T1 with the committed as-built preset (the ninth refit's,
-``ninth_refit.json``), seeds 0-9, from each start in
+``twin/plants/data/ninth_refit.json``), seeds 0-9, from each start in
 START_DEG. Starts below 24 deg put the start outside the Coulomb fit, where the twin clamps it (SPEC §4's
 resolution); the last start ends at 174 deg, the fit's other edge. It prints per start and law the RMSE (mean ±
 std over the runs), the largest error (mean), the RMS error over the move (0-1 s) and over the hold, and the
@@ -20,7 +20,6 @@ at 30 deg. The result is recorded in docs/as-built.md.
 from __future__ import annotations
 
 import math
-import pathlib
 
 import numpy as np
 
@@ -31,12 +30,11 @@ from twin.experiments.reference import (
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
 )
 from twin.physics import trajectories
-from twin.plants.as_built import as_built_plant, calibrated_values
+from twin.plants.as_built import NINTH_REFIT_FILE, as_built_plant, calibrated_values
 from twin.sim.scenario import Scenario
 
 SEEDS = range(10)
-NINTH_REFIT = pathlib.Path(__file__).with_name("ninth_refit.json")  # the committed preset when this trial ran
-PLANT = as_built_plant(calibrated_values(NINTH_REFIT))
+PLANT = as_built_plant(calibrated_values(NINTH_REFIT_FILE))
 START_DEG = (10.0, 20.0, 30.0, 40.0, 50.0, 54.0)  # deg; 30 is the committed start
 LAWS = ("pva", "ffpva", "smc")
 

@@ -2,7 +2,7 @@
 
 The rig tracked T4 with sliding mode ahead of FF + PVA (1.82 against 1.95 deg); the committed preset
 puts FF + PVA ahead. This script runs both on T4 (0 g, horizontal) for each member of the committed
-calibration's ensemble (the ninth refit's, ``ninth_refit.json``), on seeds 0-4 (the verdict's) and on seeds 40-79 (which no step of the fit
+calibration's ensemble (the ninth refit's, ``twin/plants/data/ninth_refit.json``), on seeds 0-4 (the verdict's) and on seeds 40-79 (which no step of the fit
 ran), and prints the members' profiled values and the four means. Its result (2026-11-26) is in
 docs/as-built.md.
 
@@ -11,19 +11,16 @@ docs/as-built.md.
 
 from __future__ import annotations
 
-import pathlib
-
 from twin.experiments import calibrate
-from twin.plants.as_built import ensemble_values
+from twin.plants.as_built import NINTH_REFIT_FILE, ensemble_values
 
 KEYS = [("ffpva", 4, 0.0, "horizontal"), ("smc", 4, 0.0, "horizontal")]
 FRESH = tuple(range(40, 80))
-NINTH_REFIT = pathlib.Path(__file__).with_name("ninth_refit.json")  # the committed preset when this trial ran
 
 
 def main() -> None:
     with calibrate.Evaluator(seeds=tuple(range(5)), workers=2) as evaluator:
-        for k, m in enumerate(ensemble_values(NINTH_REFIT)):
+        for k, m in enumerate(ensemble_values(NINTH_REFIT_FILE)):
             five = evaluator.cells(m, keys=KEYS)
             fresh = evaluator.cells(m, keys=KEYS, seeds=FRESH)
             print(f"{k} CCW {m['ccw_coulomb_scale']:.3f} load {m['load_friction']:.2f} K_OB {m['observer_gain']:.0f} "

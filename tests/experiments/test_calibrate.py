@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import math
-import pathlib
 
 import numpy as np
 import pytest
@@ -160,8 +159,11 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
 
 
 def test_the_second_start_is_the_ninth_refit_inside_the_box_and_one_outside_is_refused():
-    ninth = json.loads((pathlib.Path(__file__).parents[2] / "examples" / "ninth_refit.json").read_text())
-    assert calibrate.PREVIOUS_FITS == (ninth["fitted"],)  # to the last bit
+    from twin.plants.as_built import NINTH_REFIT_FILE, preset_digest
+
+    ninth = json.loads(NINTH_REFIT_FILE.read_text())
+    assert preset_digest(NINTH_REFIT_FILE) == "57ff10bf5b36"  # the ninth refit's file, as committed on 2026-11-26
+    assert calibrate.previous_fits() == (ninth["fitted"],)  # to the last bit
     box = {f.name: f for f in FITTED}
     assert all(box[n].low <= v <= box[n].high for n, v in ninth["fitted"].items())
     assert box["air_fraction"].high == 0.08 and ninth["bounds"]["air_fraction"]["high"] == 0.03
@@ -180,7 +182,9 @@ def test_the_committed_file_holds_the_second_start_as_evaluated_and_as_a_member(
     costing what the ninth refit's file says (to 1e-12: machines differ in the last bits), more than the best;
     it is the ensemble's second member, and made_by says so."""
     committed = json.loads(CALIBRATION_FILE.read_text())
-    ninth = json.loads((pathlib.Path(__file__).parents[2] / "examples" / "ninth_refit.json").read_text())
+    from twin.plants.as_built import NINTH_REFIT_FILE
+
+    ninth = json.loads(NINTH_REFIT_FILE.read_text())
     last = committed["history"][-1]
     assert last["stage"] == "previous" and last["values"] == ninth["fitted"]
     assert [h["stage"] for h in committed["history"]].count("previous") == 1
@@ -299,7 +303,7 @@ def test_same_seeds_same_fit_whatever_the_workers():
     # two points along each profiled parameter (the load friction, the breakaway, the observer gain, the CCW scale,
     # the air), then the second start, evaluated at exactly its values
     assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 10 + ["previous"]
-    assert one.history[-1].values == calibrate.PREVIOUS_FITS[0] and one.evaluations == 14
+    assert one.history[-1].values == calibrate.previous_fits()[0] and one.evaluations == 14
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)

@@ -506,7 +506,7 @@ def test_the_ninth_refit_kept_for_the_trials_is_the_preset_the_docs_quote_them_o
 
     # 57ff10bf5b36: the stamp of the pages that quote these trials (tests/test_docs.py), the committed preset
     # from 2026-11-26; the trials that ran on it read this copy, so a refit does not change what they print.
-    assert as_built.preset_digest(ROOT / "examples" / "ninth_refit.json") == "57ff10bf5b36"
+    assert as_built.preset_digest(as_built.NINTH_REFIT_FILE) == "57ff10bf5b36"
 
 
 @pytest.mark.parametrize(("heading", "folder", "member_count"), [

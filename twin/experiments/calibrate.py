@@ -35,7 +35,7 @@ Search, deterministic (the same code and seeds give the same file):
    vertical predictions turn on), then with the observer gain likewise, then with the CCW Coulomb
    scale, then with the chambers' free air; the fitted values are then the lowest cost of all evaluations (a profile point may beat
    the simplex);
-5. a second start: the values of :data:`PREVIOUS_FITS` (the ninth refit's, the best this search
+5. a second start: the values of :func:`previous_fits` (the ninth refit's, the best this search
    found with the air held to 0-3 %), evaluated on the fit seeds like any other, so that a set
    known to fit is not lost to the ensemble because the profiles, one parameter at a time about
    the best, never reach it;
@@ -62,7 +62,7 @@ from twin.experiments.reference import (
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
     THESIS_ROBUSTNESS_T1_DEG,
 )
-from twin.plants.as_built import ASSUMED, FITTED, as_built_plant
+from twin.plants.as_built import ASSUMED, FITTED, NINTH_REFIT_FILE, as_built_plant, calibrated_values
 from twin.sim.metrics import spread
 from twin.sim.scenario import Scenario
 
@@ -85,17 +85,17 @@ PROFILED = ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale", "
 ENSEMBLE_MAX = 1 + 2 * len(PROFILED)  # the best and each profiled parameter's two extremes
 FILE_VERSION = 8  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction;
 # 6: the observer gain; 7: the CCW scale's top from §4.5.1's slowest full-duty speed, and profiled;
-# 8: the air's box 0-8 % and profiled, and the second start (PREVIOUS_FITS)
-# The second start: the ninth refit's fitted values (file version 7, 2026-11-26; its file is kept as
-# examples/ninth_refit.json), the best of the same search with the air's box 0-3 %. They cost 0.5587 on the fit
-# seeds; the search with the box at 0-8 % settles at 4.6 % air for 0.5367, with a noise of 0.139, and its profiles
-# alone put no set with less than 3.98 % air in the ensemble (its 2 % point costs 0.83). Added 2026-11-27, after
-# seeing that (docs/calibration-history.md).
-PREVIOUS_FITS: tuple[dict[str, float], ...] = (
-    {"stiction": 1.089025806254227, "air_fraction": 0.028264187145978212, "ccw_coulomb_scale": 1.1610468724237357,
-     "leak_conductance": 1.3884555850178003e-14, "load_friction": 0.2926653418689966,
-     "observer_gain": 340.0855191517621},
-)
+# 8: the air's box 0-8 % and profiled, and the second start (previous_fits)
+# The second start: the ninth refit's fitted values (file version 7, 2026-11-26;
+# twin.plants.as_built.NINTH_REFIT_FILE), the best of the same search with the air's box 0-3 %. They cost 0.5587 on
+# the fit seeds; the search with the box at 0-8 % settles at 4.6 % air for 0.5367, with a noise of 0.139, and its
+# profiles alone put no set with less than 3.98 % air in the ensemble (its 2 % point costs 0.83). Added 2026-11-27,
+# after seeing that (docs/calibration-history.md).
+
+
+def previous_fits() -> tuple[dict[str, float], ...]:
+    """The second start's parameter sets: the ninth refit's fitted values, read from its kept file."""
+    return (calibrated_values(NINTH_REFIT_FILE),)
 
 
 @dataclasses.dataclass(frozen=True)
@@ -367,10 +367,12 @@ class _BudgetSpent(Exception):
 def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_seeds: Sequence[int] = CHECK_SEEDS,
               noise_seed_sets: Sequence[Sequence[int]] = NOISE_SEED_SETS, scan_points: int = SCAN_POINTS,
               simplex_evaluations: int = SIMPLEX_EVALUATIONS, profile_points: int = PROFILE_POINTS,
-              previous: Sequence[dict[str, float]] = PREVIOUS_FITS,
+              previous: Sequence[dict[str, float]] | None = None,
               progress: Callable[[int, int, str, float, dict], None] | None = None) -> Calibration:
     """Fit :data:`twin.plants.as_built.FITTED` (see the module docstring). ``previous``: the second start's
-    values (each must lie in the box). ``progress(done, total, stage, cost, values)`` after each evaluation."""
+    values (each must lie in the box; None: :func:`previous_fits`). ``progress(done, total, stage, cost, values)``
+    after each evaluation."""
+    previous = previous_fits() if previous is None else tuple(previous)
     for values in previous:
         if set(values) != {f.name for f in FITTED}:
             raise ValueError(f"a second start must give exactly the fitted parameters {[f.name for f in FITTED]}, "

@@ -771,23 +771,26 @@ def _members_right_text(detail: dict, t: int, right: Sequence[int]) -> str:
     return text
 
 
+def lead_counts(prediction: Sequence[dict], means: Sequence[float]) -> tuple[dict[str, int], int]:
+    """In how many of the T3 payload and side cells each controller has the lower of ``means`` (one per row of
+    ``prediction``, in its order), and how many cells were ranked: a cell where a mean is not a number is left
+    out, and a tie counts for neither."""
+    cells: dict[tuple, dict[str, float]] = {}
+    for r, mean in zip(prediction, means, strict=True):
+        if mean is not None and math.isfinite(mean):
+            cells.setdefault((r["payload_g"], r["orientation"]), {})[r["controller"]] = float(mean)
+    ranked = [pair for pair in cells.values() if len(pair) == 2]
+    count: dict[str, int] = {}
+    for pair in ranked:
+        if len(set(pair.values())) == 2:
+            best = min(pair, key=pair.get)
+            count[best] = count.get(best, 0) + 1
+    return count, len(ranked)
+
+
 def member_leads(prediction: Sequence[dict], detail: dict) -> list[dict[str, int]]:
-    """Per ensemble member, in how many of the T3 payload and side cells each controller has the lower mean
-    (a cell where a mean is not a number is left out; a tie counts for neither)."""
-    means = member_means(detail)
-    cells: dict[tuple, dict[str, int]] = {}
-    for i, r in enumerate(prediction):
-        cells.setdefault((r["payload_g"], r["orientation"]), {})[r["controller"]] = i
-    leads = []
-    for m in range(means.shape[1]):
-        count: dict[str, int] = {}
-        for pair in cells.values():
-            values = {c: float(means[i, m]) for c, i in pair.items() if math.isfinite(means[i, m])}
-            if len(values) == 2 and len(set(values.values())) == 2:
-                best = min(values, key=values.get)
-                count[best] = count.get(best, 0) + 1
-        leads.append(count)
-    return leads
+    """Per ensemble member, :func:`lead_counts` of its T3 means."""
+    return [lead_counts(prediction, column)[0] for column in member_means(detail).T]
 
 
 def _leads_text(count: dict[str, int], cells: int) -> str:
@@ -1569,20 +1572,11 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
         lines.append("- **Out of it** (seeds 0-4; a reading links a miss to another check, it does not prove its "
                      "cause; the sections below say more): " + ". ".join(x[0].upper() + x[1:] for x in out) + ".")
     if v.prediction:
-        pairs: dict[tuple, dict] = {}
-        for r in v.prediction:
-            if r["twin_mean"] is None or not math.isfinite(r["twin_mean"]):
-                continue  # a failed run: no mean to rank
-            pairs.setdefault((r["payload_g"], r["orientation"]), {})[r["controller"]] = r["twin_mean"]
-        both = [p for p in pairs.values() if len(p) > 1]
-        leads: dict[str, int] = {}
-        for p in both:
-            best = min(p, key=p.get)
-            leads[best] = leads.get(best, 0) + 1
+        leads, both = lead_counts(v.prediction, [r["twin_mean"] for r in v.prediction])  # a failed run ranks none
         stalls = sum(r["stalled_runs"] for r in v.prediction)
         members_text = _members_lead_text(v)[0] if both and v.prediction_detail.get("per_member") else ""
         lines.append(f"- **Blind T3 prediction** ({counted(len(v.prediction), 'cell')}): "
-                     + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {len(both)} payload and side cells"
+                     + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {both} payload and side cells"
                                   for c, n in sorted(leads.items())) + " (the committed preset)"
                         + (f"; across the ensemble, {members_text}" if members_text else "") + "; " if both else "")
                      + ("no run of any ensemble member stalls." if not stalls else
