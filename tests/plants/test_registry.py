@@ -92,3 +92,24 @@ def test_ensemble_members_are_plants_by_name_but_not_listed():
     assert not any(name.startswith("as-built~") for name in PLANTS)  # not listed, so not in the sweep hash
     with pytest.raises(KeyError):
         PLANTS[f"as-built~{len(members)}"]
+
+
+def test_ensemble_costs_are_the_files_and_every_member_is_within_the_cost_line(tmp_path):
+    """The members' recorded costs, in the members' order: the first is the fit's cost, and every one lies
+    within cost + noise, the line ``twin calibrate`` drew the ensemble by; a file that records no cost for a
+    member says None for it, and a file without an ensemble gives the fitted cost alone."""
+    from twin.plants.as_built import calibration_cost_line, ensemble_costs, ensemble_values
+
+    costs = ensemble_costs()
+    best, noise = calibration_cost_line()
+    assert len(costs) == len(ensemble_values()) and costs[0] == best
+    assert all(c is not None and best <= c <= best + noise for c in costs)
+    record = json.loads(CALIBRATION_FILE.read_text())
+    record["ensemble"][1].pop("cost")
+    record["ensemble"][2]["cost"] = "nan?"
+    path = tmp_path / "fit.json"
+    path.write_text(json.dumps(record))
+    assert ensemble_costs(path)[:3] == [best, None, None]
+    del record["ensemble"]
+    path.write_text(json.dumps(record))
+    assert ensemble_costs(path) == [best]

@@ -79,9 +79,9 @@ def _with_unit(text: str, unit: str) -> str:
 
 
 def _member_text(member: dict, names: Sequence[str]) -> str:
-    """``member``'s values of ``names``, as the report writes them ("breakaway 1.21 N and load friction ...")."""
-    return " and ".join(f"{PARAMETER_TEXT[n][0]} {_with_unit(PARAMETER_TEXT[n][1](member[n]), PARAMETER_TEXT[n][2])}"
-                        for n in names)
+    """``member``'s values of ``names``, as the report writes them ("breakaway 1.21 N, load friction ...")."""
+    return ", ".join(f"{PARAMETER_TEXT[n][0]} {_with_unit(PARAMETER_TEXT[n][1](member[n]), PARAMETER_TEXT[n][2])}"
+                     for n in names)
 
 
 def _profiled(members: Sequence[dict]) -> list[str]:
@@ -301,6 +301,16 @@ def payload_effects(seeds: Sequence[dict]) -> list[dict]:
     return rows
 
 
+UNJUDGED_VALVE_ROW = "; below the {:g} % checked"  # a valve row shown beside the checked duties, not judged
+
+
+def _judged(row: dict) -> bool:
+    """Whether a row of ``validation.csv`` is judged (a valve duty below those checked is shown, not judged)."""
+    from twin.experiments.studies import valve
+
+    return not row["source"].endswith(UNJUDGED_VALVE_ROW.format(valve.CHECKED_FROM))
+
+
 def valve_rows() -> list[dict]:
     """The §4.4.3 replica's R(d) against eq. 4.4.2 (Pa s/m^3), and the full pulse's delays (ms)."""
     from twin.experiments.studies import valve
@@ -312,7 +322,8 @@ def valve_rows() -> list[dict]:
         measured, twin = float(NOMINAL_PARAMS.valves.resistance(duty)), valve.replica(duty)[0]
         checked = duty >= valve.CHECKED_FROM
         rows.append(_row(f"4.4.3 valve test, R at {duty:g} % duty (Pa s/m^3)"
-                         + ("" if checked else "; below the 35 % checked"), None, None, None, None,
+                         + ("" if checked else UNJUDGED_VALVE_ROW.format(valve.CHECKED_FROM)), None, None, None,
+                         None,
                          "solenoid valve", measured, twin if math.isfinite(twin) else None, None,
                          checked and math.isfinite(twin) and abs(twin / measured - 1) <= valve.TOLERANCE))
     opening, closing = solenoid.delays(valve.NOMINAL_SOLENOID, h=valve.NOMINAL_SOLENOID.step)
@@ -658,9 +669,9 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     """The T3 cells on each ensemble member and on the ``committed`` values (the runs of the member
     with those values, which the ensemble lists first, else their own); see the module docstring.
     ``ran``: cells already run on ``committed`` with the evaluator's seeds, not run again for it."""
-    from twin.plants.as_built import ensemble_values
+    from twin.plants.as_built import calibration_cost_line, ensemble_costs, ensemble_values
 
-    members = ensemble_values()
+    members, costs = ensemble_values(), ensemble_costs()
     # With the fitted cells: how each miss and each order fares on every member. Each cell runs once (T3's
     # 0 g flat cells are both predicted and fitted) and is picked by its key.
     keys = PREDICTION_CELLS + tuple(key for key in calibrate.CELLS if key not in PREDICTION_CELLS)
@@ -678,7 +689,8 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     own = next((cells for values, cells in zip(members, per_member, strict=True) if values == committed), None)
     own = own or evaluator.cells(committed, keys=PREDICTION_CELLS)
     rows = prediction_rows(per_member, own)
-    detail = {"members": members, "runs": len(members) * len(SEEDS),
+    detail = {"members": members, "runs": len(members) * len(SEEDS), "costs": costs, "cost_line": calibration_cost_line(),
+              "committed": next((k for k, values in enumerate(members) if values == committed), None),
               "per_member": [[c.mean_rmse for c in m] for m in per_member],
               "orders": [_known_orders(m) for m in experiment],
               "fitted_means": [{c.key: c.mean_rmse for c in m} for m in fitted]}
@@ -700,25 +712,39 @@ def prediction_rows(per_member: Sequence[Sequence[calibrate.CellResult]],
     return rows
 
 
+def _measured_rmse_rows(v: Validation) -> list[dict]:
+    """The measured RMSE cells of ``v`` (Chapter 5 experiments and Chapter 6 T1) that the fit ran."""
+    return [r for r in v.rows if r["source"] in ("chapter 5 experiment", "chapter 6 T1")]
+
+
+def _member_within(m: dict, r: dict) -> bool | None:
+    """Whether one member's mean (``m``, its ``fitted_means``) of the measured cell ``r`` is within tolerance;
+    None where the member did not run it, or its runs give no mean (a failed run)."""
+    x = m.get((r["controller"], r["trajectory"], r["payload_g"], r["orientation"]))
+    return None if x is None or not math.isfinite(x) else bool(rmse_within(x, r["measured"]))
+
+
+def member_cells_within(v: Validation) -> list[int]:
+    """Per ensemble member, how many of the measured RMSE cells its five-run means put within tolerance
+    ([] when the members did not run them)."""
+    rows = _measured_rmse_rows(v)
+    return [sum(_member_within(m, r) is True for r in rows) for m in v.prediction_detail.get("fitted_means") or []]
+
+
 def _why_members(v: Validation) -> list[str]:
     """How many of the measured RMSE cells each ensemble member puts within tolerance, and which cells are
     out on every member ([] when the members did not run them)."""
     means = v.prediction_detail.get("fitted_means")
-    rows = [r for r in v.rows if r["source"] in ("chapter 5 experiment", "chapter 6 T1")]
+    rows = _measured_rmse_rows(v)
     if not means or not rows:
         return []
-
-    def within(m: dict, r: dict) -> bool | None:  # None: not run, or no mean (a failed run)
-        x = m.get((r["controller"], r["trajectory"], r["payload_g"], r["orientation"]))
-        return None if x is None or not math.isfinite(x) else bool(rmse_within(x, r["measured"]))
-
-    counts = [sum(within(m, r) is True for r in rows) for m in means]
-    everywhere = [r for r in rows if all(within(m, r) is False for m in means)]
-    some = [r for r in rows if not r["within_tolerance"] and any(within(m, r) is True for m in means)]
+    counts = member_cells_within(v)
+    everywhere = [r for r in rows if all(_member_within(m, r) is False for m in means)]
+    some = [r for r in rows if not r["within_tolerance"] and any(_member_within(m, r) is True for m in means)]
     return [f"- **The misses on every member** (the {len(means)} ensemble members, seeds 0-4): each puts "
             f"{min(counts)}-{max(counts)} of the {len(rows)} measured RMSE cells within {RMSE_TOLERANCE * 100:.0f} % "
-            f"(the committed preset {sum(bool(r['within_tolerance']) for r in rows)}; members in order: "
-            + ", ".join(str(c) for c in counts) + "). "
+            f"(the committed preset {sum(bool(r['within_tolerance']) for r in rows)}; each member's count is in the "
+            "members' table at the end). "
             + (("Out on every member, so not a matter of which of the equally good fits is committed: "
                 + ", ".join(_cell_name(r) for r in everywhere) + ". ") if everywhere else "")
             + (("Out on the committed preset but within on some member: " + ", ".join(_cell_name(r) for r in some)
@@ -758,17 +784,35 @@ def member_orders(detail: dict, measured: dict[int, str]) -> dict[int, list[int]
     return {t: [k for k, order in enumerate(orders) if order.get(t) == rig] for t, rig in measured.items()}
 
 
+def _and_list(items: Sequence[str]) -> str:
+    """"T1", "T1 and T2", "T1, T2 and T3"."""
+    return items[0] if len(items) == 1 else ", ".join(items[:-1]) + f" and {items[-1]}"
+
+
+def _numbers_text(members: Sequence[int]) -> str:
+    """"member 1", "members 0 and 3", "members 0, 2 and 5": ensemble members by their numbers (from 0, as the
+    members' table and ``prediction_members.csv`` number them)."""
+    return ("member " if len(members) == 1 else "members ") + _and_list([str(k) for k in members])
+
+
 def _members_right_text(detail: dict, t: int, right: Sequence[int]) -> str:
-    """How many members put trajectory ``t``'s order right, and which (by the parameters they differ in)."""
+    """How many members put trajectory ``t``'s order right, and which (by number: the members' table gives
+    their values), named by the shorter list: those right, or all but those not."""
     members = detail["members"]
     unknown = sum(order.get(t) is None for order in detail.get("orders") or [])
     text = f"right on {len(right)} of the ensemble's {len(members)} members"
     if unknown:
         text += f" ({unknown} without an order: a run failed)"
-    if 0 < len(right) < len(members):
-        names = _profiled(members)
-        text += " (" + "; ".join(_member_text(members[k], names) for k in right) + ")"
-    return text
+    return text + _which_members(len(members), right)
+
+
+def _which_members(count: int, right: Sequence[int]) -> str:
+    """" (members 2 and 4)" or " (all but member 3)", the shorter, for ``right`` among ``count`` members; "" when
+    they are none or all."""
+    if not 0 < len(right) < count:
+        return ""
+    others = [k for k in range(count) if k not in right]
+    return f" ({_numbers_text(right)})" if len(right) <= len(others) else f" (all but {_numbers_text(others)})"
 
 
 def lead_counts(prediction: Sequence[dict], means: Sequence[float]) -> tuple[dict[str, int], int]:
@@ -800,15 +844,16 @@ def _leads_text(count: dict[str, int], cells: int) -> str:
 
 
 def _members_lead_text(v: Validation) -> tuple[str, list[int]]:
-    """The T3 leads over the ensemble's members, grouped ("10 members: sliding mode ahead in 6 of 6; 1 member:
-    FF + PVA ahead in 5 of 6, sliding mode ahead in 1 of 6"), and the members whose majority law differs from
+    """The T3 leads over the ensemble's members, grouped ("on 10 members, sliding mode ahead in 6 of 6; on 1 member
+    (member 1), FF + PVA ahead in 5 of 6, sliding mode ahead in 1 of 6"), and the members whose majority law differs from
     most members' (empty if they all agree)."""
     leads = member_leads(v.prediction, v.prediction_detail)
     cells = len({(r["payload_g"], r["orientation"]) for r in v.prediction})
     groups: dict[str, list[int]] = {}
     for m, count in enumerate(leads):
         groups.setdefault(_leads_text(count, cells), []).append(m)
-    text = "; ".join(f"{counted(len(ms), 'member')}: {t}" for t, ms in sorted(groups.items(), key=lambda g: -len(g[1])))
+    text = "; ".join(f"on {counted(len(ms), 'member')}" + (f" ({_numbers_text(ms)})" if len(ms) <= 3 else "") + f", {t}"
+                     for t, ms in sorted(groups.items(), key=lambda g: -len(g[1])))
     majority = [max(count, key=count.get) if count else None for count in leads]
     usual = max(sorted(set(majority), key=str), key=majority.count)  # sorted: the same pick on every run
     return text, [m for m, c in enumerate(majority) if c != usual]
@@ -1390,8 +1435,8 @@ def _why_full_duty(rows: Sequence[dict] | None) -> list[str]:
             + (" The as-built joint breaks away from rest both ways at each pressure, as the rig did." if moved else
                " The as-built joint does **not** break away from rest both ways at each pressure (or its run "
                "failed); the rig did.")
-            + (" Its CCW way (towards 0 deg) is the slower: with its fitted CCW Coulomb scale (the thesis tracked "
-               "worse moving CCW) at 1 it runs CW / CCW at " + "; ".join(
+            + (" Its CCW way (towards 0 deg) is the slower, by its fitted CCW Coulomb scale (fitted because the "
+               "thesis tracked worse moving CCW); with that scale reset to 1 it runs CW / CCW at " + "; ".join(
                    " / ".join(_way_text(r["runs"]["as-built, no CCW scale"], w) for w in (0, 1))
                    + f" mm/s at {r['pressure'] / 1e3:g} kPa" for r in rows) + "." if ccw_slower else "")]
 
@@ -1412,13 +1457,17 @@ def _why(v: Validation) -> list[str]:
     if by_member:
         count = len(v.prediction_detail["members"])
         split = [t for t, right in by_member.items() if 0 < len(right) < count]
+        unknown = {t: sum(order.get(t) is None for order in v.prediction_detail.get("orders") or [])
+                   for t in by_member}
         lines.append(
             f"- **Controller order across the ensemble** (Chapter 5 experiments, seeds 0-4, each of the {count} "
             "members that fit the measurements about equally well): "
-            + "; ".join(f"T{t} right on {len(right)}" for t, right in by_member.items()) + ". "
-            + (" ".join(f"T{t}'s is {_members_right_text(v.prediction_detail, t, by_member[t])}." for t in split)
-               + " So within what the data allow the twin does not settle " + " and ".join(f"T{t}'s" for t in split)
-               + " order: it comes out right on some members and wrong on others, and the committed preset's "
+            + "; ".join(f"T{t} right on {len(right)}" + _which_members(count, right)
+                        + (f" ({unknown[t]} without an order: a run failed)" if unknown[t] else "")
+                        for t, right in by_member.items()) + ". "
+            + ("So within what the data allow the twin does not settle the order of "
+               + _and_list([f"T{t}" for t in split])
+               + ": it comes out right on some members and wrong on others, and the committed preset's "
                "order there is one of them, not a finding." if split else
                "Each order is right on every member or on none: the parameters the data do not pin do not "
                "turn it."))
@@ -1480,20 +1529,21 @@ def _why(v: Validation) -> list[str]:
                  f"{_spans_text(members)}, fitting the measurements about equally well. The T3 cell that depends "
                  f"on them most is {CONTROLLER_LABELS[widest['controller']]} {widest['payload_g']:g} g "
                  f"{widest['orientation']}: its members' means span {means[k].min():.2f}-{means[k].max():.2f} deg "
-                 f"({relative:.0%} of the median; 10-90 % band {widest['band_p10']:.2f}-{widest['band_p90']:.2f}), "
-                 f"from the member with {_member_text(lowest, differ)} to the one with "
-                 f"{_member_text(highest, differ)}. So within what the data allow the T3 cells' size "
+                 f"({relative:.0%} of the median; 10-90 % band {widest['band_p10']:.2f}-{widest['band_p90']:.2f})"
+                 + (f", from member {int(np.argmin(means[k]))} ({_member_text(lowest, differ)}) to member "
+                    f"{int(np.argmax(means[k]))} ({_member_text(highest, differ)})" if differ else "")
+                 + ". So within what the data allow the T3 cells' size "
                  + ("does not turn on them" if relative < RMSE_TOLERANCE else "**turns on them** there: read the "
                     "members' range, not the committed value")
                  + (" (no run of any member stalls)." if not any(r["stalled_runs"] for r in v.prediction) else
                     "; some members' runs stall, counted per cell above."))
     text, apart = _members_lead_text(v)
     if apart:
-        lines.append(f"- **Which law leads on T3 turns on which of the equally good fits holds**: on the ensemble's "
-                     f"{len(members)} members, {text}. Set apart: "
-                     + "; ".join(f"member {m} ({_member_text(members[m], _profiled(members))})" for m in apart)
-                     + " (numbered from 0 as in `prediction_members.csv`). Read the members' means there, not the "
-                     "committed preset's lead; the 10-90 % band leaves a lone member out.")
+        lines.append(f"- **Which law leads on T3 turns on which of the equally good fits holds** (the ensemble's "
+                     f"{len(members)} members): {text}. Set apart: "
+                     + _numbers_text(apart) + " (the members' table at the end gives the values). Read the members' "
+                     "means there, not the committed preset's lead; the 10-90 % band leaves a "
+                     "lone member out.")
     known = {r["controller"]: r for r in rows if r["source"] == "chapter 5 experiment" and r["trajectory"] == 3
              and r["controller"] in ("ffpva", "smc")}
     if known:
@@ -1521,7 +1571,7 @@ def _times(ratio) -> str:
 
 
 def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
-    """The report's opening: what is within the bar, what is not (each miss's size and reading), and what the
+    """The report's opening: what is within tolerance, what is not (each miss's size and reading), and what the
     blind prediction says, in three lines computed from the same rows as the tables below. Added 2026-11-27,
     after every result it reads: it says again what the tables say, in short. ``missed``: :func:`misses` of ``v``."""
     measured = [r for r in v.rows if r["source"] in ("chapter 5 experiment", "chapter 6 T1")]
@@ -1532,13 +1582,13 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
                       if (rs := [r for r in measured if r["source"] == source]))
     heavy = [r for r in measured if r["payload_g"] and r["orientation"] == "vertical"]
     stalled = sum(v.stalled.values())
-    first = f"- **Within the bar**: {len(within)} of {len(measured)} measured RMSE means ({parts})"
+    first = f"- **Within tolerance**: {len(within)} of {len(measured)} measured RMSE means ({parts})"
     if heavy:
         first += (f"; of the vertical cells with a payload, {sum(r['within_tolerance'] for r in heavy)} of "
                   f"{len(heavy)} RMSE means")
     first += (", and no run of the measured cells stalls." if not stalled else
               f"; {counted(stalled, 'run')} of the measured cells stall{'s' if stalled == 1 else ''}.")
-    checked = [r for r in v.rows if r["source"].startswith("4.4.3 valve test") and "below" not in r["source"]]
+    checked = [r for r in v.rows if r["source"].startswith("4.4.3 valve test") and _judged(r)]
     delays = [r for r in v.rows if r["source"].startswith("4.4.3 valve") and "delay" in r["source"]]
     if checked or delays:
         first += (f" The valve: R(d) within 15 % of eq. 4.4.2 at {sum(r['within_tolerance'] for r in checked)} of "
@@ -1569,19 +1619,42 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
             out.append(f"{what}, out on {sum(not r['within_tolerance'] for r in rs)} of {len(rs)}")
     lines = [first]
     if out:
-        lines.append("- **Out of it** (seeds 0-4; a reading links a miss to another check, it does not prove its "
+        lines.append("- **Outside it** (seeds 0-4; a reading links a miss to another check, it does not prove its "
                      "cause; the sections below say more): " + ". ".join(x[0].upper() + x[1:] for x in out) + ".")
     if v.prediction:
         leads, both = lead_counts(v.prediction, [r["twin_mean"] for r in v.prediction])  # a failed run ranks none
         stalls = sum(r["stalled_runs"] for r in v.prediction)
         members_text = _members_lead_text(v)[0] if both and v.prediction_detail.get("per_member") else ""
         lines.append(f"- **Blind T3 prediction** ({counted(len(v.prediction), 'cell')}): "
-                     + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {both} payload and side cells"
-                                  for c, n in sorted(leads.items())) + " (the committed preset)"
-                        + (f"; across the ensemble, {members_text}" if members_text else "") + "; " if both else "")
-                     + ("no run of any ensemble member stalls." if not stalls else
+                     + (", ".join(f"{CONTROLLER_LABELS[c]} tracks best on {n} of {both} payload and orientation "
+                                  "cells" for c, n in sorted(leads.items())) + " (the committed preset)"
+                        + (f". Across the ensemble: {members_text}" if members_text else "") + ". " if both else "")
+                     + ("No run of any ensemble member stalls." if not stalls else
                         f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}."))
     return lines
+
+
+def _terms() -> str:
+    """The words the report uses, said once at its head."""
+    from controllers.smc import SlidingModeGains
+
+    phi = next(f.default for f in dataclasses.fields(SlidingModeGains) if f.name == "boundary_layer")
+    return (
+        "Terms: **within** means within the comparison's tolerance above; **x0.44** is the twin's value over the "
+        "measured one. **SSE** is a T1 run's steady error at its end, and an **SSE range** is ± the largest |SSE| "
+        "of five runs. **Horizontal** (also *flat*): gravity along the joint's shaft; **vertical** (on its *side*): "
+        "gravity in the plane of rotation, 0 deg hanging down (inferred). Plants: **`thesis`** is what the thesis "
+        "simulated, its Chapter 4 model with the simulation gains (the valve as eq. 4.4.2 averaged over the PWM "
+        "period, with its opening and closing delays; eq. 4.5.7's friction; `thesis-deadzone` adds the valve's dead "
+        "zone); **`as-built`** is that plant plus, as physics, the effects the thesis blames for its experiments' "
+        "larger errors (among them the physical solenoid valve, the supply line, the chambers' free air, a leak and "
+        "stiction), with the experiment gains and scored on the Hall sensor; the few parameters the thesis does not "
+        "give are fitted to the measurements (`twin calibrate`). The **ensemble** is the parameter sets that fit "
+        "the measurements about equally well (within the fit's seed-to-seed noise); each is a **member**, numbered "
+        "from 0 in the members' table at the end. The **committed preset** is the fit's best values, which every "
+        "verdict uses (the table marks the member that has them). The **fresh seeds** are "
+        f"{FRESH_SEEDS[0]}-{FRESH_SEEDS[-1]}: noise seeds no step of the calibration ran. **phi** is sliding "
+        f"mode's boundary layer, {phi:g} m/s as the thesis ran it (not fitted).")
 
 
 def report(v: Validation) -> str:
@@ -1600,11 +1673,15 @@ def report(v: Validation) -> str:
              "`within` is each comparison's tolerance: ±0.35 deg for the thesis's simulations, 20 % for measured "
              "RMSE means, ±0.5 deg for T1 steady-error ranges, 15 % for the valve's R(d) from 35 % duty, 1 ms "
              "for the valve's delays.", "",
+             _terms(), "",
              "## In short", "", *_in_short(v, missed), "",
              "## Summary", "", "| comparison | plant | within tolerance |", "|---|---|---|"]
     for head, members in groups.items():
-        lines.append(f"| {head} | {members[0]['plant']} | {sum(r['within_tolerance'] for r in members)} of "
-                     f"{len(members)} |")
+        judged = [r for r in members if _judged(r)]
+        shown = len(members) - len(judged)
+        lines.append(f"| {head} | {members[0]['plant']} | {sum(r['within_tolerance'] for r in judged)} of "
+                     f"{len(judged)}" + (f" (and {counted(shown, 'row')} below the duties checked: shown, not judged)"
+                                         if shown else "") + " |")
     if v.seeds and any(r["groups"] for r in v.seeds):
         more = f"mean of {max(r['runs'] for r in v.seeds)} runs on seeds {v.seeds[0]['seeds']} (a check, not the verdict)"
         sse = [r for r in v.seeds if r["sse_twin"] is not None]
@@ -1615,31 +1692,39 @@ def report(v: Validation) -> str:
                          f"as-built | {sum(r['sse_within_tolerance'] for r in sse)} of {len(sse)} |")
     lines += ["", "![twin against measurement](validation.png)", ""]
     if missed:
-        lines += ["## Every miss against the bar, and what the other checks show about it", "",
-                  f"Each comparison the bar judges (an RMSE mean within {RMSE_TOLERANCE * 100:.0f} %, a T1 steady-error "
-                  f"range within ±{SSE_TOLERANCE_DEG:g} deg, each Chapter 5 trajectory's controller order) that misses "
-                  "on seeds 0-4, the verdict's seeds, or only on the fresh seeds' runs. `fresh seeds` is the RMSE "
-                  "ratio on the mean of their runs, the mean of their five-run groups' SSE ranges, or their order; "
-                  "then whether within (or right), and the five-run groups within. The reading is the first of "
-                  "these rules that applies (`misses.csv` has the table): **runs that failed** for a mean that is "
-                  "not a number; **the draw** when a miss on seeds 0-4 is within (an order: right) on the fresh "
-                  "seeds; **§8's largest error is off the same way** for a flat cell whose "
-                  f"largest error and the thesis's differ by more than {RMSE_TOLERANCE * 100:.0f} % in the "
-                  "direction of the miss (on the seeds it misses on); **sliding mode's opening lag** when sliding mode tracks a slow trajectory "
-                  "too badly while its closed-form lag is no more than 10 % shorter than FF + PVA's; **its 0 g flat "
-                  "level** for a Chapter 6 cell out on the fresh seeds whose payload cost there matches the rig's "
-                  f"within {EFFECT_SIGNIFICANCE:g} standard errors while its controller's 0 g flat cell is out the "
-                  "same way; **its payload's cost** for one out on the fresh seeds whose payload costs the twin "
+        lines += ["## Every miss, and what the other checks show about it", "",
+                  f"Each comparison judged against its tolerance (an RMSE mean within {RMSE_TOLERANCE * 100:.0f} %, a "
+                  f"T1 SSE range within ±{SSE_TOLERANCE_DEG:g} deg, each Chapter 5 trajectory's controller order) "
+                  "that misses on seeds 0-4 (the verdict's), or only on the fresh seeds 40-79. `off by` is the twin "
+                  "over the measured (an RMSE) or the twin less the measured (an SSE range, deg). `fresh seeds` is the "
+                  "same measure on seeds 40-79: the RMSE ratio on the mean of their runs, the mean of their five-run "
+                  "groups' SSE ranges, or their order; then whether within (or right), and how many of the eight "
+                  "five-run groups are within. A reading links a miss to another check; it is not a proof of its "
+                  "cause. It is the first of these rules that applies (`misses.csv` has the table):", "",
+                  "- **runs that failed**: a mean that is not a number;",
+                  "- **the draw**: a miss on seeds 0-4 that is within (an order: right) on the fresh seeds;",
+                  "- **§8's largest error is off the same way**: a 0 g horizontal cell whose largest error and the "
+                  f"thesis's differ by more than {RMSE_TOLERANCE * 100:.0f} % in the direction of the miss (on the "
+                  "seeds it misses on);",
+                  "- **sliding mode's opening lag**: sliding mode tracks a slow trajectory too badly while its "
+                  "closed-form lag (the error at which a law's command opens its valve on T2's ramp, from its gains"
+                  + ("; \"Slow motion in pulses\" below" if v.pulses else "") + ") is no more than 10 % shorter "
+                  "than FF + PVA's;",
+                  "- **its 0 g flat level**: a Chapter 6 cell out on the fresh seeds whose payload cost there "
+                  f"matches the rig's within {EFFECT_SIGNIFICANCE:g} standard errors while its controller's 0 g "
+                  "horizontal cell is out the same way;",
+                  "- **its payload's cost**: a Chapter 6 cell out on the fresh seeds whose payload costs the twin "
                   f"more (or less) than the rig by more than {EFFECT_SIGNIFICANCE:g} standard errors, the way it "
-                  "misses; **where the runs end scatters** (or **is off zero**) for an SSE range out on the fresh "
-                  "seeds too, by whether the twin's signed steady errors centre within half a std of zero; "
-                  "**follows** for an order that the measured values of its out cells would put right; **the "
-                  "rig's runs do not settle it** for one whose every pair the twin ranks the other way is less than "
-                  f"{EFFECT_SIGNIFICANCE:g} combined standard errors apart in the thesis's five-run means, with the "
-                  "twin's gap less than as far from the rig's; else "
-                  "**not shown by the twin**. A reading links a miss to another check; it is not a proof of its "
-                  "cause. The table and its rules were added on 2026-11-25, after every result they read; **its "
-                  "payload's cost** on 2026-11-26, after the one miss it reads; **the rig's runs do not settle it** on "
+                  "misses;",
+                  "- **where the runs end scatters** (or **is off zero**): an SSE range out on the fresh seeds too, "
+                  "by whether the twin's signed steady errors centre within half a std of zero;",
+                  "- **follows**: an order that the measured values of its out cells would put right;",
+                  "- **the rig's runs do not settle it**: an order whose every pair the twin ranks the other way is "
+                  f"less than {EFFECT_SIGNIFICANCE:g} combined standard errors apart in the thesis's five-run means, "
+                  "with the twin's gap less than as far from the rig's;",
+                  "- else **not shown by the twin**.", "",
+                  "The table and its rules were added on 2026-11-25, after every result they read; **its payload's "
+                  "cost** on 2026-11-26, after the one miss it reads; **the rig's runs do not settle it** on "
                   "2026-11-27, after the one order it reads.", "",
                   "| comparison | missed on | cell | measured | twin, seeds 0-4 | off by | fresh seeds | reading | "
                   "what the other checks show |", "|---|---|---|---|---|---|---|---|---|"]
@@ -1809,18 +1894,77 @@ def report(v: Validation) -> str:
               f"{len(d['members'])} members of the calibration ensemble (five runs each). The band is the 10-90 % "
               f"range of the members' five-run means ({_band_ends_text(len(d['members']))}, so "
               "the lowest and the highest member are listed beside it); `stalled` counts the members' runs whose "
-              f"error passed {STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell). The members, in order: "
-              + "; ".join(f"{PARAMETER_TEXT[n][0]}" + (f" ({PARAMETER_TEXT[n][2]})" if PARAMETER_TEXT[n][2] else "")
-                          + ": " + ", ".join(PARAMETER_TEXT[n][1](m[n]) for m in d["members"])
-                          for n in _profiled(d["members"])) + "." + (f" {fixed}" if fixed else ""), "",
+              f"error passed {STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell); "
+              + "the members' table below gives each member's values." + (f" {fixed}" if fixed else ""), "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | members (lowest-highest) | stalled |",
               "|---|---|---|---|---|---|---|---|---|"]
     for r, means in zip(v.prediction, member_means(d), strict=True):
         lines.append(f"| {CONTROLLER_LABELS[r['controller']]} | {r['payload_g']:g} g | {r['orientation']} | "
                      f"{_fmt(r['twin_mean'])} | {_fmt(r['band_p10'])} | {_fmt(r['band_p50'])} | {_fmt(r['band_p90'])} | "
                      f"{_fmt(float(means.min()))}-{_fmt(float(means.max()))} | {r['stalled_runs']} |")
-    lines += ["", "![prediction](prediction.png)", ""]
+    lines += ["", "![prediction](prediction.png)", ""] + _members_table(v)
     return "\n".join(lines)
+
+
+def _cost_line_text(detail: dict, costs: Sequence[float] | None) -> str:
+    """The members' table's sentence on the fit cost: how many members lie within the best cost plus its
+    seed-to-seed noise, counted from the recorded costs ("" without costs)."""
+    if not costs:
+        return ""
+    text = "The fit cost is the one the calibration recorded, on its fit seeds"
+    line = detail.get("cost_line")
+    if line:
+        best, noise = line
+        inside = sum(c <= best + noise for c in costs)
+        text += (f" (the best {best:.3f}, its seed-to-seed noise {noise:.3f}): {inside} of {len(costs)} members lie "
+                 "within the best plus the noise")
+    return text + ". "
+
+
+def _orders_right_text(detail: dict, orders: dict[int, list[int]], k: int) -> str:
+    """Member ``k``'s Chapter 5 trajectories whose controller order is right ("T1, T3"), then those whose order
+    is not known (a run failed); "none" if none is right."""
+    right = ", ".join(f"T{t}" for t, members in orders.items() if k in members) or "none"
+    known = (detail.get("orders") or [])[k] if k < len(detail.get("orders") or []) else {}
+    unknown = [t for t in orders if known.get(t) is None]
+    return right + ("; not known (a run failed): " + ", ".join(f"T{t}" for t in unknown) if unknown else "")
+
+
+def _members_table(v: Validation) -> list[str]:
+    """The ensemble's members, one row each: the values they differ in, the cost the fit recorded, and what
+    each does with the measured cells, the Chapter 5 orders and the T3 lead (the other sections name members
+    by these numbers)."""
+    d = v.prediction_detail
+    members = d["members"]
+    names = _profiled(members)
+    costs = d.get("costs")
+    costs = costs if costs and len(costs) == len(members) and all(c is not None for c in costs) else None
+    within = member_cells_within(v)
+    experiment = [r for r in v.rows if r["source"] == "chapter 5 experiment"]
+    orders = member_orders(d, _order(experiment, "measured")) if experiment else {}
+    leads = member_leads(v.prediction, d)
+    cells = len({(r["payload_g"], r["orientation"]) for r in v.prediction})
+    header = ["member"] + [_with_unit(PARAMETER_TEXT[n][0], f"({PARAMETER_TEXT[n][2]})" if PARAMETER_TEXT[n][2] else "")
+                           for n in names]
+    header += ["fit cost"] if costs else []
+    header += [f"measured RMSE cells within {RMSE_TOLERANCE * 100:.0f} % (of {len(_measured_rmse_rows(v))})"] \
+        if within else []
+    header += ["Chapter 5 order right on"] if orders else []
+    header += ["T3 lead (lower RMSE)"]
+    lines = ["### The ensemble's members", "",
+             "Numbered from 0 as in `prediction_members.csv` (and `misses.csv`); the other sections name members "
+             "by these numbers. " + _cost_line_text(d, costs)
+             + "Within, order and lead are on seeds 0-4, as the verdicts above.", "",
+             "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for k, m in enumerate(members):
+        row = [f"{k} (committed)" if k == d.get("committed") else str(k)]
+        row += [PARAMETER_TEXT[n][1](m[n]) for n in names]
+        row += [f"{costs[k]:.3f}"] if costs else []
+        row += [str(within[k])] if within else []
+        row += [_orders_right_text(d, orders, k)] if orders else []
+        row += [_leads_text(leads[k], cells)]
+        lines.append("| " + " | ".join(row) + " |")
+    return lines + [""]
 
 
 def figure_validation(rows: Sequence[dict], path: pathlib.Path) -> None:

@@ -192,6 +192,15 @@ def ensemble_values(path: pathlib.Path | None = None) -> list[dict[str, float]]:
             for k, m in enumerate(members)]
 
 
+def ensemble_costs(path: pathlib.Path | None = None) -> list[float | None]:
+    """Each ensemble member's cost on the fit seeds, as ``twin calibrate`` recorded it, in
+    :func:`ensemble_values`' order; None where the file records none."""
+    record = _record(_file(path))
+    members = record.get("ensemble") or [{"cost": record.get("cost")}]
+    costs = [m.get("cost") if isinstance(m, dict) else None for m in members]
+    return [float(c) if isinstance(c, int | float) and math.isfinite(c) else None for c in costs]
+
+
 def calibration_cost_line(path: pathlib.Path | None = None) -> tuple[float, float]:
     """The fitted values' cost and its seed-to-seed noise from ``path``: ``twin calibrate`` drew its ensemble
     from every evaluated set with cost <= cost + noise."""
@@ -269,4 +278,4 @@ def preset_digest(path: pathlib.Path | None = None) -> str:
 
 __all__ = ["ASSUMED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "FITTED",
            "FULL_DUTY_SPEED_DIGIT", "FULL_DUTY_WINDOW", "SLOWEST_FULL_DUTY_SPEED", "STICTION_SCATTER",
-           "as_built_params", "as_built_plant", "calibrated_values", "calibration_cost_line", "ensemble_plants", "ensemble_values", "preset_digest"]
+           "as_built_params", "as_built_plant", "calibrated_values", "calibration_cost_line", "ensemble_costs", "ensemble_plants", "ensemble_values", "preset_digest"]
