@@ -109,6 +109,11 @@ def test_validate_writes_the_comparisons_the_prediction_and_a_report(tmp_path):
     # The prediction `twin score` holds against measurements by default is this run's, digit for digit.
     columns, members = rows_of(out / "prediction_members.csv")
     assert columns == list(validate.PREDICTION_MEMBER_COLUMNS) and len(members) == 12 * len(ensemble_values())
+    columns, listed = rows_of(out / "members.csv")  # the members' table, its values as the calibration file's
+    assert columns == list(validate.MEMBER_COLUMNS) and len(listed) == len(ensemble_values())
+    assert [r["committed"] for r in listed] == ["true"] + ["false"] * (len(listed) - 1)
+    assert [float(r["stiction"]) for r in listed] == pytest.approx([m["stiction"] for m in ensemble_values()], rel=1e-11)
+    assert [float(r["fit_cost"]) for r in listed] == pytest.approx(ensemble_costs(), rel=1e-11)  # 12 digits in a CSV
     for fresh, packaged in zip(score.VALIDATE_FILES, score.COMMITTED_FILES, strict=True):
         assert (out / fresh).read_text() == (score.COMMITTED / packaged).read_text(), (
             f"twin/experiments/data/{packaged} is stale: copy a fresh twin validate's {fresh} there")
@@ -333,8 +338,16 @@ def test_the_members_table_gives_each_members_values_cost_cells_orders_and_lead(
             in validate._members_table(v)[2])
     v.prediction_detail["committed"] = None  # the committed values are no member's: none marked
     assert not any("(committed)" in line for line in validate._members_table(v))
+    rows = validate.member_rows(v)  # members.csv: the same, machine-readable
+    assert [r["member"] for r in rows] == [0, 1, 2] and [r["committed"] for r in rows] == [False] * 3
+    assert rows[1]["stiction"] == 1.09 and rows[1]["air_fraction"] is None  # a value the member does not carry
+    assert [r["fit_cost"] for r in rows] == [0.537, 0.559, 0.6]
+    assert [r["measured_rmse_cells_within"] for r in rows] == [1, 0, 1]
+    assert [r["chapter5_orders_right"] for r in rows] == ["1", "1 2", ""]
+    assert [(r["t3_cells_ffpva_ahead"], r["t3_cells_smc_ahead"]) for r in rows] == [(2, 1), (0, 3), (3, 0)]
     v.prediction_detail["costs"] = [0.537, None, 0.6]  # a file without a member's cost: no cost column
     assert "fit cost" not in validate._members_table(v)[4]
+    assert [r["fit_cost"] for r in validate.member_rows(v)] == [0.537, None, 0.6]
 
 
 def test_a_one_member_ensemble_names_no_members_apart():

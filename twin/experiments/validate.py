@@ -46,7 +46,7 @@ from twin.experiments.reference import (
     THESIS_FULL_DUTY_SPEEDS,
     THESIS_SIMULATED_RMSE_DEG,
 )
-from twin.plants.as_built import CCW_SCALE_BOUND, FULL_DUTY_SPEED_DIGIT, FULL_DUTY_WINDOW
+from twin.plants.as_built import CCW_SCALE_BOUND, FITTED, FULL_DUTY_SPEED_DIGIT, FULL_DUTY_WINDOW
 from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import plt
@@ -125,6 +125,12 @@ PREDICTION_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "t
 # Each ensemble member's mean per T3 cell (member 0 is the first the calibration file lists), so that the band
 # and the members' range can be read again, and the prediction scored, from the files alone (`twin score`).
 PREDICTION_MEMBER_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "member", "twin_mean")
+# One row per ensemble member (the numbers the report and misses.csv name them by): its fitted values (SI, the
+# calibration file's names), the cost the calibration recorded, and what its runs on seeds 0-4 did with the
+# measured RMSE cells, the Chapter 5 orders (right ones, space-separated) and the T3 cells (how many each law
+# tracks best in).
+MEMBER_COLUMNS = ("member", "committed", *(f.name for f in FITTED), "fit_cost", "measured_rmse_cells_within",
+                  "chapter5_orders_right", "t3_cells_ffpva_ahead", "t3_cells_smc_ahead")
 # Forty more runs per measured cell, on noise seeds no step of `twin calibrate` ever ran (it fits on
 # FIT_SEEDS and measures its cost's noise on NOISE_SEED_SETS): eight five-run groups, to show how much of
 # each verdict on seeds 0-4 is the draw of five runs. Forty, as many runs per cell as the calibration's four
@@ -1930,6 +1936,23 @@ def _orders_right_text(detail: dict, orders: dict[int, list[int]], k: int) -> st
     return right + ("; not known (a run failed): " + ", ".join(f"T{t}" for t in unknown) if unknown else "")
 
 
+def member_rows(v: Validation) -> list[dict]:
+    """``members.csv``'s rows (:data:`MEMBER_COLUMNS`), one per ensemble member; a value the run does not have
+    (a cost the file does not record, cells the members did not run) is None."""
+    d = v.prediction_detail
+    costs = d.get("costs") or []
+    within = member_cells_within(v)
+    experiment = [r for r in v.rows if r["source"] == "chapter 5 experiment"]
+    orders = member_orders(d, _order(experiment, "measured")) if experiment else {}
+    leads = member_leads(v.prediction, d)
+    return [{"member": k, "committed": k == d.get("committed"), **{f.name: m.get(f.name) for f in FITTED},
+             "fit_cost": costs[k] if k < len(costs) else None,
+             "measured_rmse_cells_within": within[k] if within else None,
+             "chapter5_orders_right": " ".join(str(t) for t, right in orders.items() if k in right) if orders else None,
+             "t3_cells_ffpva_ahead": leads[k].get("ffpva", 0), "t3_cells_smc_ahead": leads[k].get("smc", 0)}
+            for k, m in enumerate(d["members"])]
+
+
 def _members_table(v: Validation) -> list[str]:
     """The ensemble's members, one row each: the values they differ in, the cost the fit recorded, and what
     each does with the measured cells, the Chapter 5 orders and the T3 lead (the other sections name members
@@ -1952,8 +1975,8 @@ def _members_table(v: Validation) -> list[str]:
     header += ["Chapter 5 order right on"] if orders else []
     header += ["T3 lead (lower RMSE)"]
     lines = ["### The ensemble's members", "",
-             "Numbered from 0 as in `prediction_members.csv` (and `misses.csv`); the other sections name members "
-             "by these numbers. " + _cost_line_text(d, costs)
+             "Numbered from 0 as in `prediction_members.csv` and `misses.csv`; the other sections name members "
+             "by these numbers, and `members.csv` has this table with the values in SI. " + _cost_line_text(d, costs)
              + "Within, order and lead are on seeds 0-4, as the verdicts above.", "",
              "| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
     for k, m in enumerate(members):
@@ -2130,12 +2153,14 @@ class ValidateExperiment(Experiment):
 
     def file_names(self) -> tuple[str, ...]:
         return ("validation.csv", "prediction.csv", "validation.md", "prediction_members.csv", "validation.png",
-                "prediction.png", "pulses.png", "seeds.csv", "seeds.png", "effects.csv", "effects.png", "misses.csv")
+                "prediction.png", "pulses.png", "seeds.csv", "seeds.png", "effects.csv", "effects.png", "misses.csv",
+                "members.csv")
 
     def outputs(self, outcome: Outcome, out: pathlib.Path, undrawn: list[tuple[str, str]]) -> list[pathlib.Path]:
         """``validation.csv``, ``prediction.csv``, ``validation.md``, ``prediction_members.csv``
         (:func:`prediction_member_rows`) and the figures, ``seeds.csv``
-        (:func:`seed_rows`), ``effects.csv`` (:func:`payload_effects`) and ``misses.csv`` (:func:`misses`)
+        (:func:`seed_rows`), ``effects.csv`` (:func:`payload_effects`), ``misses.csv`` (:func:`misses`) and
+        ``members.csv`` (:func:`member_rows`)
         (the CLI's :meth:`publish` makes them all or nothing; a figure that cannot be drawn is left out and
         named in ``undrawn``)."""
         v = outcome.detail
@@ -2156,6 +2181,8 @@ class ValidateExperiment(Experiment):
         paths += drawn(lambda path: figure_effects(v, path), out / "effects.png", undrawn)
         paths.append(out / "misses.csv")
         write_csv(misses(v), MISS_COLUMNS, paths[-1])
+        paths.append(out / "members.csv")
+        write_csv(member_rows(v), MEMBER_COLUMNS, paths[-1])
         return paths
 
 
