@@ -805,11 +805,16 @@ def _members_right_text(detail: dict, t: int, right: Sequence[int]) -> str:
     """How many members put trajectory ``t``'s order right, and which (by number: the members' table gives
     their values), named by the shorter list: those right, or all but those not."""
     members = detail["members"]
-    unknown = sum(order.get(t) is None for order in detail.get("orders") or [])
+    unknown = len(_unknown_orders(detail, t))
     text = f"right on {len(right)} of the ensemble's {len(members)} members"
     if unknown:
         text += f" ({unknown} without an order: a run failed)"
     return text + _which_members(len(members), right)
+
+
+def _unknown_orders(detail: dict, t: int) -> list[int]:
+    """The members whose Chapter 5 order on trajectory ``t`` is not known (a run failed)."""
+    return [k for k, order in enumerate(detail.get("orders") or []) if order.get(t) is None]
 
 
 def _which_members(count: int, right: Sequence[int]) -> str:
@@ -1463,8 +1468,7 @@ def _why(v: Validation) -> list[str]:
     if by_member:
         count = len(v.prediction_detail["members"])
         split = [t for t, right in by_member.items() if 0 < len(right) < count]
-        unknown = {t: sum(order.get(t) is None for order in v.prediction_detail.get("orders") or [])
-                   for t in by_member}
+        unknown = {t: len(_unknown_orders(v.prediction_detail, t)) for t in by_member}
         lines.append(
             f"- **Controller order across the ensemble** (Chapter 5 experiments, seeds 0-4, each of the {count} "
             "members that fit the measurements about equally well): "
@@ -1931,9 +1935,17 @@ def _orders_right_text(detail: dict, orders: dict[int, list[int]], k: int) -> st
     """Member ``k``'s Chapter 5 trajectories whose controller order is right ("T1, T3"), then those whose order
     is not known (a run failed); "none" if none is right."""
     right = ", ".join(f"T{t}" for t, members in orders.items() if k in members) or "none"
-    known = (detail.get("orders") or [])[k] if k < len(detail.get("orders") or []) else {}
-    unknown = [t for t in orders if known.get(t) is None]
+    unknown = [t for t in orders if k in _unknown_orders(detail, t)]
     return right + ("; not known (a run failed): " + ", ".join(f"T{t}" for t in unknown) if unknown else "")
+
+
+def _member_facts(v: Validation) -> tuple[list[int], dict[int, list[int]], list[dict[str, int]]]:
+    """Per ensemble member, from its runs on seeds 0-4: the measured RMSE cells within tolerance
+    (:func:`member_cells_within`), per Chapter 5 trajectory the members whose order is right
+    (:func:`member_orders`; {} without the experiments' rows) and its T3 leads (:func:`member_leads`)."""
+    experiment = [r for r in v.rows if r["source"] == "chapter 5 experiment"]
+    orders = member_orders(v.prediction_detail, _order(experiment, "measured")) if experiment else {}
+    return member_cells_within(v), orders, member_leads(v.prediction, v.prediction_detail)
 
 
 def member_rows(v: Validation) -> list[dict]:
@@ -1941,10 +1953,7 @@ def member_rows(v: Validation) -> list[dict]:
     (a cost the file does not record, cells the members did not run) is None."""
     d = v.prediction_detail
     costs = d.get("costs") or []
-    within = member_cells_within(v)
-    experiment = [r for r in v.rows if r["source"] == "chapter 5 experiment"]
-    orders = member_orders(d, _order(experiment, "measured")) if experiment else {}
-    leads = member_leads(v.prediction, d)
+    within, orders, leads = _member_facts(v)
     return [{"member": k, "committed": k == d.get("committed"), **{f.name: m.get(f.name) for f in FITTED},
              "fit_cost": costs[k] if k < len(costs) else None,
              "measured_rmse_cells_within": within[k] if within else None,
@@ -1962,10 +1971,7 @@ def _members_table(v: Validation) -> list[str]:
     names = _profiled(members)
     costs = d.get("costs")
     costs = costs if costs and len(costs) == len(members) and all(c is not None for c in costs) else None
-    within = member_cells_within(v)
-    experiment = [r for r in v.rows if r["source"] == "chapter 5 experiment"]
-    orders = member_orders(d, _order(experiment, "measured")) if experiment else {}
-    leads = member_leads(v.prediction, d)
+    within, orders, leads = _member_facts(v)
     cells = len({(r["payload_g"], r["orientation"]) for r in v.prediction})
     header = ["member"] + [_with_unit(PARAMETER_TEXT[n][0], f"({PARAMETER_TEXT[n][2]})" if PARAMETER_TEXT[n][2] else "")
                            for n in names]
