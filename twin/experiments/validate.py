@@ -1114,8 +1114,9 @@ def _why_effects(v: Validation) -> list[str]:
              if r["trajectory"] == 1}
     hidden = [r for r in low + high if level.get((r["controller"], r["payload_g"], r["orientation"]))]
     if hidden:
-        line += (f"; a level within {RMSE_TOLERANCE * 100:.0f} % on the same runs hides it on " + ", ".join(
-            f"{CONTROLLER_LABELS[r['controller']]} {_effect_name(r)}" for r in hidden))
+        line += ("; of these, the RMSE check passes all the same (the cell's mean is within "
+                 f"{RMSE_TOLERANCE * 100:.0f} % on the same runs) on " + ", ".join(
+                     f"{CONTROLLER_LABELS[r['controller']]} {_effect_name(r)}" for r in hidden))
     line += "."
     return [line]
 
