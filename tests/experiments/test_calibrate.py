@@ -2,12 +2,14 @@
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import math
 
 import numpy as np
 import pytest
 
+from twin.batch.sweep import code_version
 from twin.exceptions import InvalidScenario
 from twin.experiments import calibrate
 from twin.experiments.calibrate import CellResult, cost, values_at
@@ -142,6 +144,11 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
                                    ensemble=history, wall_time=1.0, max_evaluations=2, fit_seeds=(0, 1),
                                    check_seeds=(0,), noise_seed_sets=((2, 3), (4, 5)))
     data = calibrate.record(result)
+    # the file names its own preset: the sweep store's version of the code once it is installed (here it is)
+    assert data["code_version"] == code_version()
+    other_fit = dataclasses.replace(result, values=other)
+    assert calibrate.record(other_fit)["code_version"] == code_version(plants=calibrate.fit_presets(other))
+    assert calibrate.record(other_fit)["code_version"] != code_version()  # not the preset installed when it ran
     assert data["noise"]["std"] == pytest.approx(0.02) and data["noise"]["seed_sets"] == [[0, 1], [2, 3], [4, 5]]
     assert [m["values"] for m in data["ensemble"]] == [values, other]
     (smc_t4,) = [r for r in data["residuals_fit_seeds"] if (r["controller"], r["trajectory"]) == ("smc", 4)]
@@ -325,3 +332,4 @@ def test_calibrate_retraces_the_committed_fit():
     (first,) = result.history
     assert first.values == committed["history"][0]["values"]
     assert first.cost == pytest.approx(committed["history"][0]["cost"], rel=1e-12, abs=0.0)
+

@@ -27,7 +27,7 @@ import os
 import pathlib
 import signal
 import tomllib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 
 from twin.batch.grid import GridPoint
@@ -58,9 +58,11 @@ def _package_version() -> str:
         return tomllib.loads(PYPROJECT.read_text())["project"]["version"]
 
 
-def code_version() -> str:
+def code_version(plants: Mapping | None = None) -> str:
     """What a stored row depends on besides its scenario: the package, MuJoCo, NumPy and numba
-    versions, and a hash of every plant preset's parameters, the four trajectories and the MJCF."""
+    versions, and a hash of every plant preset's parameters, the four trajectories and the MJCF.
+    ``plants``: the presets to hash in place of the registry's (``twin calibrate`` names the preset its
+    fit makes, not the one installed before it)."""
     import mujoco
     import numba
     import numpy as np
@@ -70,7 +72,8 @@ def code_version() -> str:
     from twin.plants import PLANTS
 
     trajectories = [trajectory(n, spur_radius=NOMINAL_PARAMS.gears.spur_radius) for n in (1, 2, 3, 4)]
-    params = hashlib.sha256(repr((PLANTS, trajectories)).encode() + MODEL_PATH.read_bytes()).hexdigest()[:16]
+    presets = PLANTS if plants is None else plants
+    params = hashlib.sha256(repr((presets, trajectories)).encode() + MODEL_PATH.read_bytes()).hexdigest()[:16]
     return (f"store {STORE_FORMAT}, twin {_package_version()}, mujoco {mujoco.__version__}, "
             f"numpy {np.__version__}, numba {numba.__version__}, params {params}")
 

@@ -475,11 +475,20 @@ def cell_rows(cells: Sequence[CellResult]) -> list[dict]:
     return rows
 
 
+def fit_presets(values: dict[str, float]) -> dict:
+    """The plant presets as they stand once a fit with ``values`` is installed: what its file's ``code_version``
+    hashes, so that it names the fit's own preset (the sweep store's version of the code, with it installed),
+    not the one installed when the fit ran."""
+    from twin.plants.preset import THESIS_PLANTS
+
+    return {**THESIS_PLANTS, "as-built": as_built_plant(values)}
+
+
 def record(result: Calibration) -> dict:
     """The versioned data file's content."""
     return {
         "version": FILE_VERSION,
-        "code_version": code_version(),
+        "code_version": code_version(plants=fit_presets(result.values)),
         "made_by": f"twin calibrate (Sobol scan of {SCAN_POINTS} + centre, Nelder-Mead, profiles of "
                    f"{' and '.join(PROFILED)}; "
                    + (f"a second start from the ninth refit's values ({starts}, stage 'previous'); "
