@@ -476,12 +476,13 @@ def cell_rows(cells: Sequence[CellResult]) -> list[dict]:
 
 
 def fit_presets(values: dict[str, float]) -> dict:
-    """The plant presets as they stand once a fit with ``values`` is installed: what its file's ``code_version``
-    hashes, so that it names the fit's own preset (the sweep store's version of the code, with it installed),
-    not the one installed when the fit ran."""
-    from twin.plants.preset import THESIS_PLANTS
+    """The plant registry's presets as they stand once a fit with ``values`` is installed (its ``as-built``
+    in place of whatever is installed, or added if nothing is): what its file's ``code_version`` hashes, so
+    that it names the fit's own preset (the sweep store's version of the code, with it installed)."""
+    from twin.plants import PLANTS
 
-    return {**THESIS_PLANTS, "as-built": as_built_plant(values)}
+    presets = {name: (as_built_plant(values) if name == "as-built" else PLANTS[name]) for name in PLANTS}
+    return presets if "as-built" in presets else {**presets, "as-built": as_built_plant(values)}
 
 
 def record(result: Calibration) -> dict:

@@ -761,14 +761,13 @@ def _members_within_text(detail: dict, r: dict) -> str:
     """On how many ensemble members the measured cell ``r`` (a validation row) is within tolerance, and
     the span of their ratios; "" when ``prediction``'s detail has no member means for it."""
     key = (r["controller"], r["trajectory"], r["payload_g"], r["orientation"])
-    means = [m[key] for m in detail.get("fitted_means") or [] if key in m]
-    if not means:
+    ran = [m for m in detail.get("fitted_means") or [] if key in m]
+    if not ran:
         return ""
-    finite = [x for x in means if math.isfinite(x)]  # a member whose runs failed has no mean
-    within = sum(rmse_within(x, r["measured"]) for x in finite)
-    ratios = [x / r["measured"] for x in finite]
+    within = sum(_member_within(m, r) is True for m in ran)  # a member whose runs failed has no mean: not counted
+    ratios = [m[key] / r["measured"] for m in ran if math.isfinite(m[key])]
     span = f"; x{min(ratios):.2f}-x{max(ratios):.2f}" if ratios else ""
-    return f"; within on {within} of the ensemble's {len(means)} members (seeds 0-4{span})"
+    return f"; within on {within} of the ensemble's {len(ran)} members (seeds 0-4{span})"
 
 
 def _known_orders(cells: Sequence[calibrate.CellResult]) -> dict[int, str | None]:
@@ -805,16 +804,19 @@ def _members_right_text(detail: dict, t: int, right: Sequence[int]) -> str:
     """How many members put trajectory ``t``'s order right, and which (by number: the members' table gives
     their values), named by the shorter list: those right, or all but those not."""
     members = detail["members"]
-    unknown = len(_unknown_orders(detail, t))
-    text = f"right on {len(right)} of the ensemble's {len(members)} members"
-    if unknown:
-        text += f" ({unknown} without an order: a run failed)"
+    text = f"right on {len(right)} of the ensemble's {len(members)} members" + _unknown_text(detail, t)
     return text + _which_members(len(members), right)
 
 
 def _unknown_orders(detail: dict, t: int) -> list[int]:
     """The members whose Chapter 5 order on trajectory ``t`` is not known (a run failed)."""
     return [k for k, order in enumerate(detail.get("orders") or []) if order.get(t) is None]
+
+
+def _unknown_text(detail: dict, t: int) -> str:
+    """" (2 without an order: a run failed)" for trajectory ``t``, or "" when every member's order is known."""
+    unknown = len(_unknown_orders(detail, t))
+    return f" ({unknown} without an order: a run failed)" if unknown else ""
 
 
 def _which_members(count: int, right: Sequence[int]) -> str:
@@ -1469,12 +1471,11 @@ def _why(v: Validation) -> list[str]:
     if by_member:
         count = len(v.prediction_detail["members"])
         split = [t for t, right in by_member.items() if 0 < len(right) < count]
-        unknown = {t: len(_unknown_orders(v.prediction_detail, t)) for t in by_member}
         lines.append(
             f"- **Controller order across the ensemble** (Chapter 5 experiments, seeds 0-4, each of the {count} "
             "members that fit the measurements about equally well): "
             + "; ".join(f"T{t} right on {len(right)}" + _which_members(count, right)
-                        + (f" ({unknown[t]} without an order: a run failed)" if unknown[t] else "")
+                        + _unknown_text(v.prediction_detail, t)
                         for t, right in by_member.items()) + ". "
             + ("So within what the data allow the twin does not settle the order of "
                + _and_list([f"T{t}" for t in split])
