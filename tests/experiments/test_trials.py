@@ -144,6 +144,73 @@ def test_trial_t1_start_prints_what_as_built_md_quotes(capsys):
     }
 
 
+@pytest.mark.slow  # about 20 s on 2 cores: T3's 13 cells three ways and T2's three cells five ways, five seeds
+def test_trial_t2_t3_choices_prints_what_the_docs_quote(capsys):
+    import twin.sim.simulation as simulation
+
+    committed = simulation.trajectory
+    _load("trial_t2_t3_choices").main()
+    assert simulation.trajectory is committed  # the trial puts the committed trajectories back
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "T3: the 10 s runs' first 4 s give the committed runs bit for bit: True"
+    assert out[16] == "T2: the 1.2 s runs' first 1 s give the committed runs bit for bit: True"
+    rows = dict(line.split(": ", 1) for line in out[2:16] + out[18:])
+    # cell -> mean RMSE per choice (T3: the first 2 / 4 / 6 / 8 / 10 s, from the trough; T2: the first 0.5 /
+    # 0.75 / 1 / 1.2 s, from 24 / 40 / 50 deg), the largest over the smallest, stalled runs, x the rig's
+    assert rows == {
+        "pva T3 0 g horizontal": "3.06 / 3.04 / 3.04 / 3.05 / 3.05 / 3.06 | x1.009 | stalled 0 | the rig 3.00: "
+                                 "x1.01 as committed, x1.01-x1.02",
+        "ffpva T3 0 g horizontal": "2.35 / 2.38 / 2.35 / 2.34 / 2.33 / 2.33 | x1.021 | stalled 0 | the rig 2.09: "
+                                   "x1.14 as committed, x1.11-x1.14",
+        "ffpva T3 6.5 g horizontal": "2.49 / 2.58 / 2.62 / 2.63 / 2.65 / 2.60 | x1.067 | stalled 0",
+        "ffpva T3 13.5 g horizontal": "2.87 / 2.86 / 2.91 / 2.92 / 2.92 / 2.91 | x1.024 | stalled 0",
+        "ffpva T3 0 g vertical": "2.36 / 2.33 / 2.33 / 2.36 / 2.39 / 2.30 | x1.039 | stalled 0",
+        "ffpva T3 6.5 g vertical": "2.57 / 2.60 / 2.59 / 2.65 / 2.68 / 2.63 | x1.041 | stalled 0",
+        "ffpva T3 13.5 g vertical": "3.67 / 3.66 / 3.68 / 3.69 / 3.69 / 3.92 | x1.070 | stalled 0",
+        "smc T3 0 g horizontal": "2.19 / 2.21 / 2.18 / 2.18 / 2.19 / 2.22 | x1.023 | stalled 0 | the rig 1.69: "
+                                 "x1.30 as committed, x1.29-x1.32",
+        "smc T3 6.5 g horizontal": "2.40 / 2.42 / 2.38 / 2.38 / 2.39 / 2.41 | x1.016 | stalled 0",
+        "smc T3 13.5 g horizontal": "2.63 / 2.61 / 2.58 / 2.61 / 2.61 / 2.58 | x1.019 | stalled 0",
+        "smc T3 0 g vertical": "2.17 / 2.22 / 2.19 / 2.19 / 2.20 / 2.21 | x1.025 | stalled 0",
+        "smc T3 6.5 g vertical": "2.39 / 2.41 / 2.42 / 2.43 / 2.44 / 2.52 | x1.051 | stalled 0",
+        "smc T3 13.5 g vertical": "3.39 / 3.42 / 3.41 / 3.40 / 3.41 / 3.52 | x1.041 | stalled 0",
+        "T3, sliding mode ahead of FF + PVA in how many of the 6 cells": "2 s 6 / 4 s 6 / 6 s 6 / 8 s 6 / 10 s 6 / "
+                                                                          "trough 6",
+        "pva T2 0 g horizontal": "2.92 / 2.88 / 2.91 / 3.05 / 2.86 / 3.03 / 2.84 | x1.073 | stalled 0 | the rig "
+                                 "2.93: x0.99 as committed, x0.97-x1.04",
+        "ffpva T2 0 g horizontal": "2.47 / 2.37 / 2.37 / 2.42 / 2.42 / 2.34 / 2.38 | x1.055 | stalled 0 | the rig "
+                                   "2.08: x1.14 as committed, x1.13-x1.19",
+        "smc T2 0 g horizontal": "2.24 / 2.25 / 2.30 / 2.36 / 2.19 / 2.30 / 2.38 | x1.091 | stalled 0 | the rig "
+                                 "1.55: x1.49 as committed, x1.41-x1.54",
+    }
+
+
+@pytest.mark.slow  # about 50 s on 2 cores: ten T1 and twelve T3 cells at seven supply pressures, five seeds
+def test_trial_chapter6_supply_prints_what_prediction_md_quotes(capsys):
+    _load("trial_chapter6_supply").main()
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "T3 at 300 kPa gives the committed runs bit for bit: True"
+    rows = dict(line.split(": ", 1) for line in out[2:])
+    # pressure -> Chapter 6 T1 cells within 20 %, the 13.5 g vertical T1 cells x the measured; T3 mean RMSE per
+    # cell (FF + PVA | sliding mode; 0 / 6.5 / 13.5 g horizontal, then vertical; * a stalled run); the lead
+    assert rows == {
+        "285 kPa": "T1 6 of 10, 13.5 g V x1.33 / x1.65; T3 2.38 2.66 2.88 2.37 2.61 5.42 | 2.19 2.44 2.67 2.25 2.41 4.84; "
+                   "smc ahead 6 of 6",
+        "290 kPa": "T1 7 of 10, 13.5 g V x1.15 / x1.41; T3 2.37 2.61 2.90 2.41 2.70 4.53 | 2.19 2.42 2.63 2.20 2.42 4.17; "
+                   "smc ahead 6 of 6",
+        "295 kPa": "T1 8 of 10, 13.5 g V x0.96 / x1.21; T3 2.32 2.64 2.91 2.34 2.65 4.04 | 2.21 2.38 2.62 2.24 2.44 3.74; "
+                   "smc ahead 6 of 6",
+        "300 kPa": "T1 9 of 10, 13.5 g V x0.89 / x0.95; T3 2.38 2.58 2.86 2.33 2.60 3.66 | 2.21 2.42 2.61 2.22 2.41 3.42; "
+                   "smc ahead 6 of 6",
+        "305 kPa": "T1 8 of 10, 13.5 g V x0.76 / x0.86; T3 2.30 2.69 2.95 2.32 2.70 3.45 | 2.22 2.42 2.64 2.25 2.43 3.10; "
+                   "smc ahead 6 of 6",
+        "310 kPa": "T1 7 of 10, 13.5 g V x0.68 / x0.78; T3 2.42 2.54 2.95 2.33 2.72 3.37 | 2.23 2.39 2.60 2.22 2.43 2.95; "
+                   "smc ahead 6 of 6",
+        "315 kPa": "T1 7 of 10, 13.5 g V x0.56 / x0.76; T3 2.40 2.74 3.01 2.38 2.71 3.27 | 2.20 2.40 2.63 2.21 2.42 2.79; "
+                   "smc ahead 6 of 6",
+    }
+
+
 @pytest.mark.slow  # about 1 min: §8's eleven cells, ten seeds, nine ways (the plain runs and eight delays)
 def test_trial_actuation_delay_prints_what_as_built_md_quotes(capsys):
     from twin.physics.valves import ValveBank

@@ -175,6 +175,42 @@ def test_report_says_plainly_what_misses_and_what_the_runs_show():
     assert "some members' runs stall" in other
 
 
+def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
+    """The prediction section states T3's middle, amplitude and length as ``trajectories`` makes them and the
+    supply pressure as the as-built plant has it (SPEC §7 and §9 fix only some of these), says the band holds
+    none of them, and points to the trials, which exist."""
+    import dataclasses
+
+    import twin.plants
+    from twin.physics import trajectories
+
+    text = validate.report(_fake(1.0, lag_within=True, stalled=0))
+    section = text[text.index("## Prediction: Chapter 6 T3 (blind)"):]
+    assert ("T3 as the twin runs it: 80 ± 60 deg at 0.5 Hz for 4 s, starting mid-stroke at full speed" in section
+            and "at a supply of 300 kPa, Chapter 5's" in section and "the band holds none of them" in section)
+    for trial in ("trial_t2_t3_choices", "trial_chapter6_supply"):
+        assert f"`examples/{trial}.py`" in section
+        assert (pathlib.Path(__file__).resolve().parents[2] / "examples" / f"{trial}.py").is_file()
+    committed, preset = trajectories.trajectory, twin.plants.plant
+
+    def longer(number, *, spur_radius):
+        t = committed(number, spur_radius=spur_radius)
+        if number != 3:
+            return t
+        (sine,) = t.segments
+        return trajectories.Trajectory(3, math.radians(70.0), (trajectories.Segment("sine", 6.0, sine.delta),))
+
+    def lower(name):
+        p = preset(name)
+        supply = dataclasses.replace(p.params.supply, pressure=250e3)
+        return dataclasses.replace(p, params=dataclasses.replace(p.params, supply=supply))
+
+    monkeypatch.setattr(trajectories, "trajectory", longer)
+    monkeypatch.setattr(twin.plants, "plant", lower)
+    other = validate.report(_fake(1.0, True, 0))
+    assert "T3 as the twin runs it: 70 ± 60 deg at 0.5 Hz for 6 s" in other and "at a supply of 250 kPa" in other
+
+
 def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_says():
     """The opening lines count the same rows as the tables: 3 of the fake's 7 measured means within, its one
     vertical payload cell out, each RMSE miss with its size and reading, the order wrong on T2 of T1-T2, the

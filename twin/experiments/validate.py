@@ -92,6 +92,25 @@ def _profiled(members: Sequence[dict]) -> list[str]:
             + [n for n in carried if n not in calibrate.PROFILED and len({m[n] for m in members}) > 1])
 
 
+def _t3_as_run_text() -> str:
+    """Sentences on the T3 cells as the twin runs them: T3 (``twin.physics.trajectories``; its middle, amplitude
+    and length, which SPEC §7 does not fix all of) and the supply pressure (the as-built plant's, which §9 does
+    not restate for Chapter 6), and where to read how much they matter. Added 2026-11-27 (stop 38)."""
+    from twin.physics.trajectories import trajectory
+    from twin.plants import plant
+
+    params = plant("as-built").params
+    t3 = trajectory(3, spur_radius=params.gears.spur_radius)
+    (sine,) = t3.segments
+    return (f"T3 as the twin runs it: {math.degrees(t3.start):g} ± {math.degrees(sine.delta):g} deg at 0.5 Hz for "
+            f"{t3.duration:g} s, starting mid-stroke at full speed (the thesis simulated its largest error at T3's start), "
+            f"at a supply of {params.supply.pressure / 1e3:g} kPa, Chapter 5's. The thesis states neither T3's length "
+            "nor its start, nor restates the supply for Chapter 6, and the band holds none of them: it is the spread "
+            "over the fitted parameters with these held. The repository's docs/prediction.md has a trial of each "
+            "(`examples/trial_t2_t3_choices.py`, `examples/trial_chapter6_supply.py`); the 13.5 g vertical cells turn "
+            "on the supply most.")
+
+
 def _fixed_text(members: Sequence[dict]) -> str:
     """A sentence on the fitted parameters every member of ``members`` shares and the fit never profiled
     (:func:`_profiled` leaves them out), or "" if there are none."""
@@ -1907,7 +1926,8 @@ def report(v: Validation) -> str:
               f"range of the members' five-run means ({_band_ends_text(len(d['members']))}, so "
               "the lowest and the highest member are listed beside it); `stalled` counts the members' runs whose "
               f"error passed {STALL_ERROR_DEG:g} deg (out of {d['runs']} per cell); "
-              + "the members' table below gives each member's values." + (f" {fixed}" if fixed else ""), "",
+              + "the members' table below gives each member's values." + (f" {fixed}" if fixed else "")
+              + f" {_t3_as_run_text()}", "",
               "| controller | payload | orientation | committed | p10 | p50 | p90 | members (lowest-highest) | stalled |",
               "|---|---|---|---|---|---|---|---|---|"]
     for r, means in zip(v.prediction, member_means(d), strict=True):
