@@ -4,12 +4,14 @@ SPEC §9: Chapter 6 does not restate its supply pressure; the twin infers Chapte
 Chapter 6 cell there. Lifting 13.5 g on its side is near the edge of what 300 kPa can do (P A = 3.77 N against
 the payload's weight through the gears, the friction and the losses), so those cells may turn on the pressure
 more than on anything the ensemble's band holds. The measured T1 cells of Chapter 6 were run at the same
-unknown pressure, so they bound it, as far as the twin reads them.
+unknown pressure, but the fitted values were fitted to them at 300 kPa: what they pin is the margin for lifting
+13.5 g, which the pressure shares with the load friction and the breakaway. Only the plant's supply moves here;
+the controllers' feed-forward keeps its fixed 300 kPa (SPEC §6), as the rig's would have.
 
 This script runs, on the committed as-built preset and seeds 0-4 (the verdicts' seeds), Chapter 6's ten T1
 cells that are not §8's (FF + PVA and sliding mode; 6.5 g and 13.5 g horizontal; 0, 6.5 and 13.5 g vertical)
 and the blind prediction's twelve T3 cells at each supply pressure of PRESSURES_KPA, nothing refitted. At
-300 kPa the runs are the committed ones (the script checks it, bit for bit, against runs with the plant's own
+300 kPa the T3 runs are the committed ones (the script checks it, bit for bit, against runs with the plant's own
 pressure). It prints per pressure:
 - the T1 cells within 20 % of their measured means (of ten), and the two 13.5 g vertical T1 cells against
   theirs;
@@ -29,7 +31,7 @@ import numpy as np
 
 from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_ROBUSTNESS_T1_DEG
-from twin.experiments.validate import STALL_ERROR_DEG
+from twin.experiments.validate import STALL_ERROR_DEG, rmse_within
 from twin.physics.model import Orientation
 from twin.sim.scenario import Scenario
 
@@ -73,7 +75,7 @@ def main() -> None:
     for kpa in PRESSURES_KPA:
         t1 = dict(zip(T1_CELLS, cells_runs(1, T1_CELLS, kpa * 1e3), strict=True))
         t3 = dict(zip(T3_CELLS, cells_runs(3, T3_CELLS, kpa * 1e3), strict=True))
-        within = sum(abs(mean_rmse(runs) / measured(*cell) - 1.0) <= 0.2 for cell, runs in t1.items())
+        within = sum(bool(rmse_within(mean_rmse(runs), measured(*cell))) for cell, runs in t1.items())
         heavy = " / ".join(f"x{mean_rmse(t1[law, 13.5, Orientation.VERTICAL]) / measured(law, 13.5, Orientation.VERTICAL):.2f}"
                            for law in LAWS)
         cells = " | ".join(" ".join(f"{mean_rmse(t3[cell]):.2f}" + "*" * stalled(t3[cell]) for cell in T3_CELLS

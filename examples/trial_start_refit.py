@@ -6,19 +6,19 @@ joint turned on its side the start decides where the payload's weight acts durin
 vertical T1 cells, which pin how much margin the joint has to lift 13.5 g, read differently from another start.
 Run without ``--start``, this script shows how much, on the committed preset with nothing refitted: the six
 vertical T1 cells (FF + PVA and sliding mode, 0, 6.5 and 13.5 g) from each start of UNFITTED_STARTS_DEG, seeds
-0-4, against the measured means (about 20 s). T3's angles are fixed by §7, so the T3 cells do not depend on the start directly;
-they do through the fit. This script measures that: it sets the start (``trajectories.START``, before the fit's
+0-4, against the measured means (about 20 s). T3 does not read this start (it starts at 80 deg), so the T3 cells
+do not depend on it directly; they may through the fit. This script measures that: it sets the start (``trajectories.START``, before the fit's
 workers fork, so they inherit it) and runs the calibration exactly as ``twin calibrate`` does (the same box,
 seeds, budgets, profiles and second start), then the T3 prediction's twelve cells on every member of the
 refitted ensemble, seeds 0-4, as ``twin validate`` runs them. Starts tried: 20 deg (T3's own lowest angle: the
-rig may have run T1 over T3's 20-140 deg, where its Hall sensor is linear, §5) and 40 deg.
+rig may have run T1 over T3's 20-140 deg, where its Hall sensor is linear, §5), 25 deg and 40 deg.
 
 It prints the fitted values, the cost and its noise, the members, the measured cells within 20 % on seeds 0-4,
 and each T3 cell's value on the best, its band and the members' range, the stalled runs, and per member which
 law leads in each cell. ``--out DIR`` also writes the calibration file there; ``--calibration FILE`` reports a
 file written before without fitting again (about 1 min), with the start it was fitted at. The files of
 2026-11-27 are in ``examples/trial_start_refit/``. Nothing is installed, and the T3 cells' measurements were not
-seen. The fit takes 5-8 min on 2 cores. The result is recorded in docs/prediction.md; a slow test in
+seen. The fit takes 6-10 min on 2 cores. The result is recorded in docs/prediction.md; a slow test in
 tests/experiments/test_trials.py holds the printed numbers of the kept files.
 
     python examples/trial_start_refit.py
@@ -37,6 +37,7 @@ import sys
 
 import numpy as np
 
+from twin.batch.sweep import code_version
 from twin.envs.runner import run_many
 from twin.experiments import calibrate
 from twin.experiments.reference import THESIS_ROBUSTNESS_T1_DEG
@@ -59,6 +60,12 @@ def started_at(degrees: float):
         yield
     finally:
         trajectories.START = committed
+
+
+def params_hash(version: str) -> str:
+    """The presets', trajectories' and model's hash in a ``code_version`` string (not the package versions,
+    which a fresh install may move)."""
+    return version.rsplit("params ", 1)[-1]
 
 
 def unfitted() -> None:
@@ -131,6 +138,9 @@ def main(argv: list[str] | None = None) -> None:
     with started_at(args.start):
         if args.calibration:
             data = json.loads(args.calibration.read_text())
+            if params_hash(data["code_version"]) != params_hash(code_version(plants=calibrate.fit_presets(data["fitted"]))):
+                parser.error(f"{args.calibration} was not fitted from {args.start:g} deg by this code (its presets, "
+                             "trajectories and model hash to another value)")
         else:
             result = fit(args.workers)
             data = calibrate.record(result)

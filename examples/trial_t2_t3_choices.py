@@ -66,14 +66,16 @@ T2_CELLS = tuple((law, 0.0, Orientation.HORIZONTAL) for law in ("pva", "ffpva", 
 
 @dataclasses.dataclass(frozen=True)
 class FromTrough(Trajectory):
-    """T3 from its lowest point at rest: 80 - 60 cos(pi t) deg over the one segment's duration."""
+    """A 0.5 Hz sine from its lowest point at rest: ``start`` (the trough) + a (1 - cos(pi t)) over its one
+    segment, a = the segment's ``delta``; T3 with start 20 deg and a = 60 deg."""
 
     def sample(self, t: np.ndarray, spur_radius: float) -> Reference:
-        w = math.pi
+        (sine,) = self.segments
+        w, a, middle = math.pi, sine.delta, self.start + sine.delta
         inside = t < self.duration
-        theta = np.where(inside, MIDDLE - AMPLITUDE * np.cos(w * t), MIDDLE - AMPLITUDE * math.cos(w * self.duration))
-        omega = np.where(inside, AMPLITUDE * w * np.sin(w * t), 0.0)
-        alpha = np.where(inside, AMPLITUDE * w * w * np.cos(w * t), 0.0)
+        theta = np.where(inside, middle - a * np.cos(w * t), middle - a * math.cos(w * self.duration))
+        omega = np.where(inside, a * w * np.sin(w * t), 0.0)
+        alpha = np.where(inside, a * w * w * np.cos(w * t), 0.0)
         return Reference(position=theta * spur_radius, velocity=omega * spur_radius, acceleration=alpha * spur_radius)
 
 

@@ -211,6 +211,86 @@ def test_trial_chapter6_supply_prints_what_prediction_md_quotes(capsys):
     }
 
 
+@pytest.mark.slow  # about 2 min on 2 cores: the T3 cells on every member of three kept trial calibrations
+def test_trial_start_refit_reports_what_prediction_md_quotes(capsys):
+    """The kept trial calibrations (fitted from 20, 25 and 40 deg on 2026-11-27) give, reported again, what the fits
+    printed and docs/prediction.md quotes; a file is refused at a start it was not fitted from; the trial puts the
+    committed start back."""
+    from twin.physics import trajectories
+
+    trial, folder, committed = _load("trial_start_refit"), ROOT / "examples" / "trial_start_refit", trajectories.START
+    printed = {}
+    for start in ("20", "25", "40"):
+        trial.main(["--start", start, "--calibration", str(folder / f"start_{start}.json"), "--workers", "2"])
+        printed[start] = capsys.readouterr().out.splitlines()
+    assert trajectories.START == committed
+    with pytest.raises(SystemExit):
+        trial.main(["--start", "30", "--calibration", str(folder / "start_20.json")])
+    assert "was not fitted from 30 deg by this code" in capsys.readouterr().err
+    assert printed == {
+        "20": [
+            'T1, T2 and T4 from 20 deg (committed: 30)',
+            'fitted: stiction 1.395, air_fraction 0.045, ccw_coulomb_scale 1, leak_conductance 1.687e-14, load_friction 0.45, observer_gain 515',
+            'cost 0.5613, noise 0.0639; 67 evaluations; 6 members',
+            'measured cells within 20 % on seeds 0-4 (best): 16 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.28  2.28-2.31  2.28-2.33  0',
+            '  ffpva   6.5 g horizontal 2.65  2.60-2.67  2.59-2.68  0',
+            '  ffpva  13.5 g horizontal 2.91  2.88-2.98  2.85-3.00  0',
+            '  ffpva     0 g vertical   2.34  2.31-2.37  2.31-2.38  0',
+            '  ffpva   6.5 g vertical   2.59  2.58-2.66  2.56-2.66  0',
+            '  ffpva  13.5 g vertical   4.84  4.78-4.85  4.77-4.86  0',
+            '  smc       0 g horizontal 2.22  2.20-2.26  2.19-2.29  0',
+            '  smc     6.5 g horizontal 2.37  2.38-2.43  2.37-2.44  0',
+            '  smc    13.5 g horizontal 2.59  2.56-2.62  2.55-2.63  0',
+            '  smc       0 g vertical   2.21  2.20-2.25  2.19-2.26  0',
+            '  smc     6.5 g vertical   2.43  2.41-2.45  2.40-2.47  0',
+            '  smc    13.5 g vertical   4.28  4.28-4.32  4.28-4.33  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+        ],
+        "25": [
+            'T1, T2 and T4 from 25 deg (committed: 30)',
+            'fitted: stiction 1.678, air_fraction 0.04192, ccw_coulomb_scale 1.138, leak_conductance 1.723e-14, load_friction 0.3, observer_gain 471.1',
+            'cost 0.5233, noise 0.1032; 67 evaluations; 11 members',
+            'measured cells within 20 % on seeds 0-4 (best): 17 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.32  2.28-2.37  2.19-2.39  0',
+            '  ffpva   6.5 g horizontal 2.53  2.53-2.60  2.53-2.61  0',
+            '  ffpva  13.5 g horizontal 2.83  2.79-2.89  2.76-2.89  0',
+            '  ffpva     0 g vertical   2.18  2.18-2.31  2.16-2.40  0',
+            '  ffpva   6.5 g vertical   2.62  2.53-2.66  2.50-2.69  0',
+            '  ffpva  13.5 g vertical   3.56  3.55-4.22  3.54-4.65  0',
+            '  smc       0 g horizontal 2.22  2.20-2.25  2.20-2.26  0',
+            '  smc     6.5 g horizontal 2.30  2.30-2.42  2.29-2.42  0',
+            '  smc    13.5 g horizontal 2.60  2.58-2.62  2.58-2.62  0',
+            '  smc       0 g vertical   2.14  2.18-2.25  2.14-2.26  0',
+            '  smc     6.5 g vertical   2.43  2.38-2.46  2.36-2.48  0',
+            '  smc    13.5 g vertical   3.39  3.39-3.95  3.38-4.36  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSFSS SSSSSS SSSSSS SSSSSS SSSSSS FSSSSS SSSSSS SSSSSS SSSSSS SSSFSS',
+        ],
+        "40": [
+            'T1, T2 and T4 from 40 deg (committed: 30)',
+            'fitted: stiction 1, air_fraction 0.04, ccw_coulomb_scale 1, leak_conductance 1.034e-14, load_friction 0.2837, observer_gain 458.3',
+            'cost 0.5656, noise 0.0886; 66 evaluations; 8 members',
+            'measured cells within 20 % on seeds 0-4 (best): 16 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.30  2.27-2.36  2.26-2.38  0',
+            '  ffpva   6.5 g horizontal 2.51  2.66-2.84  2.51-2.93  0',
+            '  ffpva  13.5 g horizontal 2.82  3.01-3.25  2.82-3.28  0',
+            '  ffpva     0 g vertical   2.29  2.27-2.35  2.20-2.37  0',
+            '  ffpva   6.5 g vertical   2.59  2.64-2.88  2.59-2.89  0',
+            '  ffpva  13.5 g vertical   3.55  3.62-3.84  3.55-3.92  0',
+            '  smc       0 g horizontal 2.17  2.15-2.19  2.13-2.21  0',
+            '  smc     6.5 g horizontal 2.39  2.35-2.40  2.33-2.41  0',
+            '  smc    13.5 g horizontal 2.54  2.54-2.64  2.54-2.64  0',
+            '  smc       0 g vertical   2.18  2.14-2.20  2.13-2.23  0',
+            '  smc     6.5 g vertical   2.40  2.38-2.46  2.38-2.47  0',
+            '  smc    13.5 g vertical   3.31  3.23-3.34  3.14-3.35  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+        ],
+    }
+
+
 @pytest.mark.slow  # about 1 min: §8's eleven cells, ten seeds, nine ways (the plain runs and eight delays)
 def test_trial_actuation_delay_prints_what_as_built_md_quotes(capsys):
     from twin.physics.valves import ValveBank

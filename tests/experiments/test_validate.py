@@ -177,8 +177,8 @@ def test_report_says_plainly_what_misses_and_what_the_runs_show():
 
 def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
     """The prediction section states T3's middle, amplitude and length as ``trajectories`` makes them and the
-    supply pressure as the as-built plant has it (SPEC §7 and §9 fix only some of these), says the band holds
-    none of them, and points to the trials, which exist."""
+    supply pressure as the as-built plant has it (SPEC §7 and §9 fix only some of these; "Chapter 5's" only when
+    it is), says the band does not include them, and points to the trials, which exist."""
     import dataclasses
 
     import twin.plants
@@ -187,8 +187,10 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
     text = validate.report(_fake(1.0, lag_within=True, stalled=0))
     section = text[text.index("## Prediction: Chapter 6 T3 (blind)"):]
     assert ("T3 as the twin runs it: 80 ± 60 deg at 0.5 Hz for 4 s, starting mid-stroke at full speed" in section
-            and "at a supply of 300 kPa, Chapter 5's" in section and "the band holds none of them" in section)
-    for trial in ("trial_t2_t3_choices", "trial_chapter6_supply"):
+            and "at a supply of 300 kPa, Chapter 5's;" in section
+            and "the band does not include the uncertainty of any of them" in section)
+    assert "fitted on the measured cells with T1, T2 and T4 run from 30 deg" in section
+    for trial in ("trial_t2_t3_choices", "trial_chapter6_supply", "trial_start_refit"):
         assert f"`examples/{trial}.py`" in section
         assert (pathlib.Path(__file__).resolve().parents[2] / "examples" / f"{trial}.py").is_file()
     committed, preset = trajectories.trajectory, twin.plants.plant
@@ -206,9 +208,11 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
         return dataclasses.replace(p, params=dataclasses.replace(p.params, supply=supply))
 
     monkeypatch.setattr(trajectories, "trajectory", longer)
+    monkeypatch.setattr(trajectories, "START", math.radians(40.0))
     monkeypatch.setattr(twin.plants, "plant", lower)
     other = validate.report(_fake(1.0, True, 0))
-    assert "T3 as the twin runs it: 70 ± 60 deg at 0.5 Hz for 6 s" in other and "at a supply of 250 kPa" in other
+    assert "T3 as the twin runs it: 70 ± 60 deg at 0.5 Hz for 6 s" in other and "at a supply of 250 kPa;" in other
+    assert "with T1, T2 and T4 run from 40 deg" in other
 
 
 def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_says():

@@ -94,21 +94,28 @@ def _profiled(members: Sequence[dict]) -> list[str]:
 
 def _t3_as_run_text() -> str:
     """Sentences on the T3 cells as the twin runs them: T3 (``twin.physics.trajectories``; its middle, amplitude
-    and length, which SPEC §7 does not fix all of) and the supply pressure (the as-built plant's, which §9 does
-    not restate for Chapter 6), and where to read how much they matter. Added 2026-11-27 (stop 38)."""
+    and length, which SPEC §7 does not fix all of), the supply pressure (the as-built plant's, which §9 does not
+    restate for Chapter 6) and where the fitted cells' T1, T2 and T4 start, and where to read how much they
+    matter. Added 2026-11-27 (stop 38), after the trials it points to."""
+    from twin.physics.params import NOMINAL_PARAMS
     from twin.physics.trajectories import trajectory
     from twin.plants import plant
 
     params = plant("as-built").params
     t3 = trajectory(3, spur_radius=params.gears.spur_radius)
     (sine,) = t3.segments
+    chapter5 = ", Chapter 5's" if params.supply.pressure == NOMINAL_PARAMS.supply.pressure else ""
+    t1 = trajectory(1, spur_radius=params.gears.spur_radius)
     return (f"T3 as the twin runs it: {math.degrees(t3.start):g} ± {math.degrees(sine.delta):g} deg at 0.5 Hz for "
             f"{t3.duration:g} s, starting mid-stroke at full speed (the thesis simulated its largest error at T3's start), "
-            f"at a supply of {params.supply.pressure / 1e3:g} kPa, Chapter 5's. The thesis states neither T3's length "
-            "nor its start, nor restates the supply for Chapter 6, and the band holds none of them: it is the spread "
-            "over the fitted parameters with these held. The repository's docs/prediction.md has a trial of each "
-            "(`examples/trial_t2_t3_choices.py`, `examples/trial_chapter6_supply.py`); the 13.5 g vertical cells turn "
-            "on the supply most.")
+            f"at a supply of {params.supply.pressure / 1e3:g} kPa{chapter5}; the committed preset was fitted on the "
+            f"measured cells with T1, T2 and T4 run from {math.degrees(t1.start):g} deg. The thesis states neither T3's length nor its start "
+            "nor where T1, T2 and T4 started, nor restates the supply for Chapter 6, and the band does not include the "
+            "uncertainty of any of them: it is the spread over the fitted parameters with these held. "
+            "docs/prediction.md in the repository records a trial of each (`examples/trial_t2_t3_choices.py`, "
+            "`examples/trial_chapter6_supply.py`, `examples/trial_start_refit.py`). The 13.5 g vertical cells depend "
+            "on them most, above all on where T1 started, through the fit: in the trial, refitted about as well with "
+            "T1, T2 and T4 from 20 deg, they come out far above this band.")
 
 
 def _fixed_text(members: Sequence[dict]) -> str:
