@@ -6,7 +6,7 @@ the payload's weight through the gears, the friction and the losses), so those c
 more than on anything the ensemble's band holds. The measured T1 cells of Chapter 6 were run at the same
 unknown pressure, but the fitted values were fitted to them at 300 kPa: what they pin is the margin for lifting
 13.5 g, which the pressure shares with the load friction and the breakaway. Only the plant's supply moves here;
-the controllers' feed-forward keeps its fixed 300 kPa (SPEC §6), as the rig's would have.
+the controllers' feed-forward keeps its fixed 300 kPa (SPEC §6), as the rig's presumably did.
 
 This script runs, on the committed as-built preset and seeds 0-4 (the verdicts' seeds), Chapter 6's ten T1
 cells that are not §8's (FF + PVA and sliding mode; 6.5 g and 13.5 g horizontal; 0, 6.5 and 13.5 g vertical)

@@ -211,25 +211,38 @@ def test_trial_chapter6_supply_prints_what_prediction_md_quotes(capsys):
     }
 
 
-@pytest.mark.slow  # about 2 min on 2 cores: the T3 cells on every member of three kept trial calibrations
+@pytest.mark.slow  # about 3 min on 2 cores: six vertical T1 cells from six starts; 21 cells and T3 on four files
 def test_trial_start_refit_reports_what_prediction_md_quotes(capsys):
-    """The kept trial calibrations (fitted from 20, 25 and 40 deg on 2026-11-27) give, reported again, what the fits
-    printed and docs/prediction.md quotes; a file is refused at a start it was not fitted from; the trial puts the
-    committed start back."""
+    """The committed preset's vertical T1 cells from each start, nothing refitted, and the kept trial calibrations
+    (fitted from 20, 22, 25 and 40 deg on 2026-11-27), reported again, give what the fits printed and
+    docs/prediction.md quotes: the measured cells run again from each file's start give the file's own table (so
+    the start reaches the forked workers), then the T3 cells on every member. A file is refused at a start it was
+    not fitted from; the trial puts the committed start back."""
     from twin.physics import trajectories
 
     trial, folder, committed = _load("trial_start_refit"), ROOT / "examples" / "trial_start_refit", trajectories.START
+    trial.main([])  # the committed preset's vertical T1 cells from six starts, nothing refitted
+    assert capsys.readouterr().out.splitlines() == [
+        'T1 vertical, committed preset, nothing refitted, seeds 0-4: mean RMSE (deg) FF + PVA 0 / 6.5 / 13.5 g, then sliding mode; the rig 1.63 / 1.72 / 4.55 / 1.57 / 1.51 / 3.48',
+        'from 20 deg: 1.67 / 1.91 / 3.28 / 1.49 / 1.65 / 3.05',
+        'from 24 deg: 1.63 / 1.73 / 3.36 / 1.63 / 1.69 / 3.12',
+        'from 30 deg: 1.48 / 1.83 / 4.05 / 1.52 / 1.66 / 3.32',
+        'from 40 deg: 1.85 / 1.99 / 4.54 / 1.78 / 2.06 / 4.05',
+        'from 50 deg: 1.90 / 1.91 / 4.82 / 1.74 / 1.84 / 4.16',
+        'from 54 deg: 2.34 / 2.04 / 4.72 / 2.07 / 2.07 / 4.44',
+    ]
     printed = {}
-    for start in ("20", "25", "40"):
+    for start in ("20", "22", "25", "40"):
         trial.main(["--start", start, "--calibration", str(folder / f"start_{start}.json"), "--workers", "2"])
         printed[start] = capsys.readouterr().out.splitlines()
     assert trajectories.START == committed
     with pytest.raises(SystemExit):
         trial.main(["--start", "30", "--calibration", str(folder / "start_20.json")])
-    assert "was not fitted from 30 deg by this code" in capsys.readouterr().err
+    assert "was not fitted from 30 deg with these presets" in capsys.readouterr().err
     assert printed == {
         "20": [
             'T1, T2 and T4 from 20 deg (committed: 30)',
+            "the measured cells run again from this start: 16 of 21 within 20 %, each mean as the file's: True",
             'fitted: stiction 1.395, air_fraction 0.045, ccw_coulomb_scale 1, leak_conductance 1.687e-14, load_friction 0.45, observer_gain 515',
             'cost 0.5613, noise 0.0639; 67 evaluations; 6 members',
             'measured cells within 20 % on seeds 0-4 (best): 16 of 21',
@@ -248,8 +261,30 @@ def test_trial_start_refit_reports_what_prediction_md_quotes(capsys):
             '  smc    13.5 g vertical   4.28  4.28-4.32  4.28-4.33  0',
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
         ],
+        "22": [
+            'T1, T2 and T4 from 22 deg (committed: 30)',
+            "the measured cells run again from this start: 16 of 21 within 20 %, each mean as the file's: True",
+            'fitted: stiction 1.762, air_fraction 0.03822, ccw_coulomb_scale 1.144, leak_conductance 1.827e-14, load_friction 0.3133, observer_gain 506.1',
+            'cost 0.7127, noise 0.1225; 67 evaluations; 11 members',
+            'measured cells within 20 % on seeds 0-4 (best): 16 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.37  2.28-2.45  2.07-2.45  0',
+            '  ffpva   6.5 g horizontal 2.61  2.53-2.65  2.43-2.67  0',
+            '  ffpva  13.5 g horizontal 2.82  2.64-2.99  2.63-3.00  0',
+            '  ffpva     0 g vertical   2.38  2.33-2.38  2.15-2.40  0',
+            '  ffpva   6.5 g vertical   2.62  2.54-2.68  2.47-2.68  0',
+            '  ffpva  13.5 g vertical   3.65  3.51-3.87  3.19-4.80  0',
+            '  smc       0 g horizontal 2.25  2.21-2.27  2.18-2.36  0',
+            '  smc     6.5 g horizontal 2.46  2.41-2.61  2.38-2.73  0',
+            '  smc    13.5 g horizontal 2.63  2.63-2.73  2.56-2.87  0',
+            '  smc       0 g vertical   2.18  2.18-2.28  2.18-2.36  0',
+            '  smc     6.5 g vertical   2.52  2.41-2.59  2.41-2.73  0',
+            '  smc    13.5 g vertical   3.43  3.37-3.97  2.92-4.45  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS FFFFFS SSSSSS SSSSSS SSSSSS SSSSSS SFFSFF SSSSSS SSSSSS',
+        ],
         "25": [
             'T1, T2 and T4 from 25 deg (committed: 30)',
+            "the measured cells run again from this start: 17 of 21 within 20 %, each mean as the file's: True",
             'fitted: stiction 1.678, air_fraction 0.04192, ccw_coulomb_scale 1.138, leak_conductance 1.723e-14, load_friction 0.3, observer_gain 471.1',
             'cost 0.5233, noise 0.1032; 67 evaluations; 11 members',
             'measured cells within 20 % on seeds 0-4 (best): 17 of 21',
@@ -270,6 +305,7 @@ def test_trial_start_refit_reports_what_prediction_md_quotes(capsys):
         ],
         "40": [
             'T1, T2 and T4 from 40 deg (committed: 30)',
+            "the measured cells run again from this start: 16 of 21 within 20 %, each mean as the file's: True",
             'fitted: stiction 1, air_fraction 0.04, ccw_coulomb_scale 1, leak_conductance 1.034e-14, load_friction 0.2837, observer_gain 458.3',
             'cost 0.5656, noise 0.0886; 66 evaluations; 8 members',
             'measured cells within 20 % on seeds 0-4 (best): 16 of 21',

@@ -96,7 +96,9 @@ def _t3_as_run_text() -> str:
     """Sentences on the T3 cells as the twin runs them: T3 (``twin.physics.trajectories``; its middle, amplitude
     and length, which SPEC §7 does not fix all of), the supply pressure (the as-built plant's, which §9 does not
     restate for Chapter 6) and where the fitted cells' T1, T2 and T4 start, and where to read how much they
-    matter. Added 2026-11-27 (stop 38), after the trials it points to."""
+    matter. The start is ``trajectories.START`` as the report runs: the committed calibration was fitted with it,
+    since its ``code_version`` (which hashes the trajectories) is the sweep store's. The trial's numbers are the
+    tenth refit's and said as such. Added 2026-11-27 (stop 38), after the trials it points to."""
     from twin.physics.params import NOMINAL_PARAMS
     from twin.physics.trajectories import trajectory
     from twin.plants import plant
@@ -113,9 +115,10 @@ def _t3_as_run_text() -> str:
             "nor where T1, T2 and T4 started, nor restates the supply for Chapter 6, and the band does not include the "
             "uncertainty of any of them: it is the spread over the fitted parameters with these held. "
             "docs/prediction.md in the repository records a trial of each (`examples/trial_t2_t3_choices.py`, "
-            "`examples/trial_chapter6_supply.py`, `examples/trial_start_refit.py`). The 13.5 g vertical cells depend "
-            "on them most, above all on where T1 started, through the fit: in the trial, refitted about as well with "
-            "T1, T2 and T4 from 20 deg, they come out far above this band.")
+            "`examples/trial_chapter6_supply.py`, `examples/trial_start_refit.py`); the 13.5 g vertical cells depend "
+            "on them most. On the tenth refit (committed 2026-11-27), refitted about as well with T1, T2 and T4 from "
+            "20 deg, those two cells came out 4.84 and 4.28 deg (FF + PVA, sliding mode), above that preset's band "
+            "(whose tops were 3.81 and 3.48).")
 
 
 def _fixed_text(members: Sequence[dict]) -> str:
