@@ -190,6 +190,8 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
             and "at a supply of 300 kPa, Chapter 5's;" in section
             and "the band does not include the uncertainty of any of them" in section)
     assert "fitted on the measured cells with T1, T2 and T4 run from 30 deg" in section
+    opening = text[text.index("## In short"):text.index("## Summary")]
+    assert "- **Blind T3 prediction**" in opening and "not over the choices the thesis leaves open" in opening
     for trial in ("trial_t2_t3_choices", "trial_chapter6_supply", "trial_start_refit"):
         assert f"`examples/{trial}.py`" in section
         assert (pathlib.Path(__file__).resolve().parents[2] / "examples" / f"{trial}.py").is_file()

@@ -1671,7 +1671,10 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
                                   "cells" for c, n in sorted(leads.items())) + " (the committed preset)"
                         + (f". Across the ensemble: {members_text}" if members_text else "") + ". " if both else "")
                      + ("No run of any ensemble member stalls." if not stalls else
-                        f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}."))
+                        f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}.")
+                     + " The band is the spread over the fitted parameters only, not over the choices the thesis "
+                       "leaves open (T3's length and start, the supply, where T1, T2 and T4 started), which the "
+                       "prediction section names.")
     return lines
 
 
