@@ -37,7 +37,8 @@ from twin.sim.scenario import Scenario
 
 SEEDS = range(5)
 PLANT = "as-built"
-PRESSURES_KPA = (285.0, 290.0, 295.0, 300.0, 305.0, 310.0, 315.0)  # 300 is the inferred one the twin runs
+INFERRED_KPA = 300.0  # the supply the twin runs Chapter 6 at (SPEC §9: Chapter 5's, inferred)
+PRESSURES_KPA = (285.0, 290.0, 295.0, INFERRED_KPA, 305.0, 310.0, 315.0)
 LAWS = ("ffpva", "smc")
 T1_CELLS = tuple((law, grams, side) for law in LAWS for side in Orientation for grams in (0.0, 6.5, 13.5)
                  if (grams, side) != (0.0, Orientation.HORIZONTAL))  # 0 g flat is §8's, at Chapter 5's pressure
@@ -65,16 +66,16 @@ def measured(law: str, grams: float, side: Orientation) -> float:
 
 
 def main() -> None:
-    plain = cells_runs(3, T3_CELLS, None)
+    plain, inferred = cells_runs(3, T3_CELLS, None), cells_runs(3, T3_CELLS, INFERRED_KPA * 1e3)
     same = all(np.array_equal(a.scored_angle, b.scored_angle)
-               for p, q in zip(plain, cells_runs(3, T3_CELLS, 300e3), strict=True) for a, b in zip(p, q, strict=True))
+               for p, q in zip(plain, inferred, strict=True) for a, b in zip(p, q, strict=True))
     print(f"T3 at 300 kPa gives the committed runs bit for bit: {same}")
     print("as-built, seeds 0-4, each pressure (kPa): Chapter 6 T1 cells within 20 % (of 10), the 13.5 g vertical "
           "T1 cells x the measured (FF + PVA, sliding mode); T3 mean RMSE (deg) per cell, FF + PVA then sliding "
           "mode, 0 / 6.5 / 13.5 g horizontal then vertical, a star per stalled run; sliding mode ahead in how many")
     for kpa in PRESSURES_KPA:
         t1 = dict(zip(T1_CELLS, cells_runs(1, T1_CELLS, kpa * 1e3), strict=True))
-        t3 = dict(zip(T3_CELLS, cells_runs(3, T3_CELLS, kpa * 1e3), strict=True))
+        t3 = dict(zip(T3_CELLS, inferred if kpa == INFERRED_KPA else cells_runs(3, T3_CELLS, kpa * 1e3), strict=True))
         within = sum(bool(rmse_within(mean_rmse(runs), measured(*cell))) for cell, runs in t1.items())
         heavy = " / ".join(f"x{mean_rmse(t1[law, 13.5, Orientation.VERTICAL]) / measured(law, 13.5, Orientation.VERTICAL):.2f}"
                            for law in LAWS)

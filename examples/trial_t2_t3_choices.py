@@ -99,10 +99,11 @@ def errors(cell_runs: list) -> np.ndarray:
     return np.array([r.trace.desired_angle - r.scored_angle for r in cell_runs])
 
 
-def window_rmse(cell_runs: list, seconds: float) -> float:
-    """The runs' mean RMSE (deg) over their first ``seconds``."""
-    inside = cell_runs[0].trace.time < seconds - 1e-9
-    return float(np.mean(np.degrees(np.sqrt(np.mean(np.square(errors(cell_runs)[:, inside]), axis=1)))))
+def window_rmses(cell_runs: list, windows: tuple[float, ...]) -> list[float]:
+    """The runs' mean RMSE (deg) over their first ``seconds``, for each of ``windows``."""
+    time, error = cell_runs[0].trace.time, errors(cell_runs)
+    return [float(np.mean(np.degrees(np.sqrt(np.mean(np.square(error[:, time < seconds - 1e-9]), axis=1)))))
+            for seconds in windows]
 
 
 def mean_rmse(cell_runs: list) -> float:
@@ -116,7 +117,11 @@ def stalled(cell_runs: list) -> int:
 
 def windows_give_the_runs(long: list[list], plain: list[list]) -> bool:
     """Whether each long run's first ticks are the committed run's errors, bit for bit."""
-    return all(np.array_equal(errors(lo)[:, :errors(p).shape[1]], errors(p)) for lo, p in zip(long, plain, strict=True))
+    def same(lo: list, p: list) -> bool:
+        short = errors(p)
+        return np.array_equal(errors(lo)[:, :short.shape[1]], short)
+
+    return all(same(lo, p) for lo, p in zip(long, plain, strict=True))
 
 
 def row(law: str, mass: float, side: Orientation, number: int, values: list[float], stalls: int) -> str:
@@ -139,7 +144,7 @@ def t3() -> None:
           "the trough (4 s); the largest over the smallest; stalled runs of the 10 s and trough runs")
     table = {}
     for cell, lo, tr in zip(T3_CELLS, long, trough, strict=True):
-        table[cell] = [window_rmse(lo, w) for w in T3_WINDOWS] + [mean_rmse(tr)]
+        table[cell] = window_rmses(lo, T3_WINDOWS) + [mean_rmse(tr)]
         print(row(*cell, 3, table[cell], stalled(lo) + stalled(tr)), flush=True)
     choices = [f"{w:g} s" for w in T3_WINDOWS] + ["trough"]
     leads = []
@@ -158,7 +163,7 @@ def t2() -> None:
     print("T2, as-built, seeds 0-4: mean RMSE (deg) over the first 0.5 / 0.75 / 1 (committed) / 1.2 s from 30 "
           "deg, then 1 s from 24 / 40 / 50 deg; the largest over the smallest; stalled runs of all")
     for i, cell in enumerate(T2_CELLS):
-        values = [window_rmse(long[i], w) for w in T2_WINDOWS] + [mean_rmse(s[i]) for s in starts]
+        values = window_rmses(long[i], T2_WINDOWS) + [mean_rmse(s[i]) for s in starts]
         print(row(*cell, 2, values, stalled(long[i]) + sum(stalled(s[i]) for s in starts)), flush=True)
 
 
