@@ -14,17 +14,20 @@ slow motion would differ. This script runs that what-if two ways:
 * ``on the sum``: the compensation applied every 1 ms to u_FF+PVA plus the switching term;
 
 beside the law as the thesis gives it, on the nine cells sliding mode was measured on (§8's T1-T4, §9's
-five T1 payload cells), seeds 0-9, on the committed as-built preset (the ninth refit's, ``twin/plants/data/ninth_refit.json``), with FF + PVA and PVA + DZC on §8's
-cells for the controller order. It also runs the six Chapter 6 T3 cells (0 / 6.5 / 13.5 g, horizontal and
+five T1 payload cells), seeds 0-9, with FF + PVA and PVA + DZC on §8's cells for the controller order. It ran
+first (2026-11-27) on the ninth refit's preset, committed then (``twin/plants/data/ninth_refit.json``, the
+default); ``--preset committed`` runs it on the committed preset (added in stop 39, 2026-11-27, on the tenth
+refit's). It also runs the six Chapter 6 T3 cells (0 / 6.5 / 13.5 g, horizontal and
 vertical) with both laws, to show what each reading would predict there and which law would lead: a
 what-if beside the blind prediction, which stays as committed. Nothing is refitted. The result is
 recorded in docs/studies-and-whatifs.md.
 
-    python examples/trial_smc_compensation.py
+    python examples/trial_smc_compensation.py [--preset ninth|committed]
 """
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
@@ -36,11 +39,11 @@ from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_PAYLOADS_G, THESIS_ROBUSTNESS_T1_DEG
 from twin.experiments.validate import PREDICTION_CELLS, _order, rmse_within
 from twin.physics.model import Orientation
-from twin.plants.as_built import NINTH_REFIT_FILE, as_built_plant, calibrated_values
+from twin.plants.as_built import CALIBRATION_FILE, NINTH_REFIT_FILE, as_built_plant, calibrated_values, preset_digest
 from twin.sim.scenario import Scenario
 
 SEEDS = range(10)
-PLANT = as_built_plant(calibrated_values(NINTH_REFIT_FILE))
+PRESETS = {"ninth": NINTH_REFIT_FILE, "committed": CALIBRATION_FILE}  # which calibration file the trial runs on
 BAND = FeedForwardPVAGains(pva=PVAGains()).compensation_band  # %, eq. 5.3.6, FF + PVA's compensation
 # (trajectory, payload g, orientation, measured mean RMSE deg): §8's and §9's sliding mode cells
 SMC_CELLS = (*((t, 0.0, "horizontal", THESIS_EXPERIMENT_RMSE_DEG["smc"][t][0]) for t in (1, 2, 3, 4)),
@@ -65,21 +68,23 @@ def on_the_sum(self, t, measurement, setpoint):
     return np.clip(compensate(self._held + self.switching(measurement, setpoint), BAND), -100.0, 100.0)
 
 
-def mean_rmse(cells: list[tuple[str, int, float, str]]) -> list[float]:
-    """Each (controller, trajectory, payload g, orientation) cell's mean RMSE over :data:`SEEDS` (deg), all
-    in one batch."""
-    runs = run_many([Scenario(c, t, payload=g * 1e-3, orientation=Orientation(o), plant=PLANT, seed=s)
+def mean_rmse(plant, cells: list[tuple[str, int, float, str]]) -> list[float]:
+    """Each (controller, trajectory, payload g, orientation) cell's mean RMSE on ``plant`` over :data:`SEEDS`
+    (deg), all in one batch."""
+    runs = run_many([Scenario(c, t, payload=g * 1e-3, orientation=Orientation(o), plant=plant, seed=s)
                      for c, t, g, o in cells for s in SEEDS])
     rmse = [math.degrees(r.metrics.rmse) for r in runs]
     return [float(np.mean(rmse[i:i + len(SEEDS)])) for i in range(0, len(rmse), len(SEEDS))]
 
 
-def main() -> None:
+def main(preset: str = "ninth") -> None:
+    plant = as_built_plant(calibrated_values(PRESETS[preset]))
     flat = [(law, t, 0.0, "horizontal") for law in ("ffpva", "pva") for t in THESIS_EXPERIMENT_RMSE_DEG[law]]
-    base = mean_rmse(flat + [("ffpva", 3, g, o) for g, o in T3_CELLS])
+    base = mean_rmse(plant, flat + [("ffpva", 3, g, o) for g, o in T3_CELLS])
     others, ffpva_t3 = dict(zip(flat, base[:len(flat)], strict=True)), base[len(flat):]
     ffpva = {t: others["ffpva", t, 0.0, "horizontal"] for t in (1, 2, 3, 4)}
-    print("as-built, seeds 0-9, mean RMSE (deg) and x measured; FF + PVA T1-T4 "
+    print(f"as-built preset {preset_digest(PRESETS[preset])} ({preset}), seeds 0-9, mean RMSE (deg) and x measured; "
+          "FF + PVA T1-T4 "
           + " / ".join(f"{ffpva[t]:.2f}" for t in (1, 2, 3, 4)) + ", PVA + DZC T1-T3 "
           + " / ".join(f"{others['pva', t, 0.0, 'horizontal']:.2f}" for t in (1, 2, 3)))
     print("Chapter 6 T3 (0 / 6.5 / 13.5 g horizontal, then vertical), FF + PVA: "
@@ -89,7 +94,7 @@ def main() -> None:
         for label, update in (("as the thesis gives it", as_given), ("on the held part", on_the_held_part),
                               ("on the sum", on_the_sum)):
             smc.SlidingMode.update = update
-            everything = mean_rmse([("smc", t, g, o) for t, g, o, _ in SMC_CELLS]
+            everything = mean_rmse(plant, [("smc", t, g, o) for t, g, o, _ in SMC_CELLS]
                                    + [("smc", 3, g, o) for g, o in T3_CELLS])
             means, t3 = everything[:len(SMC_CELLS)], everything[len(SMC_CELLS):]
             within = sum(bool(rmse_within(m, c[3])) for m, c in zip(means, SMC_CELLS, strict=True))
@@ -117,4 +122,7 @@ def _orders_right(twin: dict) -> int:
 
 
 if __name__ == "__main__":
-    main()
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--preset", choices=sorted(PRESETS), default="ninth",
+                        help="the calibration file to run on (default: the ninth refit's, as first run)")
+    main(parser.parse_args().preset)
