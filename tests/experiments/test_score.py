@@ -117,7 +117,8 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     assert "6 of 12 T3 cells within 20 %" in text and "before any T3 measurement was seen" in text
     from twin.plants.as_built import preset_digest
 
-    assert f"Prediction: the committed one, `twin validate` on as-built preset {preset_digest()}." in text
+    assert (f"Prediction: the sixth blind prediction (the tenth refit's; the committed one), registered 2026-11-27 "
+            f"(the package's `twin/experiments/data/`; `twin validate` on as-built preset {preset_digest()})." in text)
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["orders.csv", "score.csv", "score.md",
                                                                                     "score.png"]
     assert sorted(score.EXPERIMENT.file_names()) == sorted(p.name for p in out.iterdir() if not p.name.startswith("."))
@@ -128,10 +129,17 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     (lambda rows: rows + rows[:1], "line 14: FF + PVA 0 g horizontal is given twice"),
     (lambda rows: [{**rows[0], "controller": "pva"}, *rows[1:]], "line 2: controller must be ffpva or smc"),
     (lambda rows: [{**rows[0], "payload_g": "5"}, *rows[1:]], "line 2: no T3 cell FF + PVA 5 g horizontal"),
-    (lambda rows: [{**rows[0], "rmse_std_deg": "-1"}, *rows[1:]], "line 2: rmse_std_deg must be a number of at least 0"),
-    (lambda rows: [{**rows[0], "rmse_mean_deg": "nan"}, *rows[1:]], "line 2: rmse_mean_deg must be a number of at least 0.01"),
-    (lambda rows: [{**rows[0], "rmse_mean_deg": "1e-320"}, *rows[1:]], "line 2: rmse_mean_deg must be a number of at"),
-    (lambda rows: [{**rows[0], "rmse_mean_deg": "1_3"}, *rows[1:]], "line 2: rmse_mean_deg must be a number of at"),
+    (lambda rows: [{**rows[0], "rmse_std_deg": "-1"}, *rows[1:]], "line 2: rmse_std_deg must be a number from 0 to 180"),
+    (lambda rows: [{**rows[0], "rmse_std_deg": "1e308"}, *rows[1:]], "line 2: rmse_std_deg must be a number from 0 to 180"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "nan"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from 0.241 to 180"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "1e-320"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "1_3"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from"),
+    # Degrees: a mean below the Hall sensor's noise is most likely radians, one over half a turn no RMSE.
+    (lambda rows: [{**r, "rmse_mean_deg": math.radians(float(r["rmse_mean_deg"]) * 2)} for r in rows],
+     "radians would be about 57 times smaller"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "1e308"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from 0.241 to 180"),
+    (lambda rows: [{**rows[0], "stalled_runs": "1"}, *rows[1:]],
+     "gives stalled_runs on 1 of the 12 cells (not on FF + PVA 6.5 g horizontal): give it on every cell or on none"),
     (lambda rows: [{**rows[0], "runs": "1"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000, got '1'"),
     (lambda rows: [{**rows[0], "runs": "\u00b2"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000"),
     (lambda rows: [{**rows[0], "stalled_runs": "6"}, *rows[1:]], "line 2: stalled_runs must be a whole number from 0 to 5"),
@@ -153,6 +161,10 @@ def test_missing_inputs_and_malformed_files_are_one_line_errors(tmp_path, capsys
     text = good.read_text()
     header, first, *rest = text.splitlines(keepends=True)
     cases = {
+        # A misspelt optional column would be read as not given (five runs, no stalls): refused instead.
+        "misspelt.csv": (header.rstrip("\n") + ",n_runs\n" + "".join(line.rstrip("\n") + ",10\n"
+                                                                       for line in [first, *rest]),
+                         "has the column(s) n_runs, which are not read"),
         "none.csv": (None, "measured file"),
         "lacking.csv": ("".join(line.rsplit(",", 1)[0] + "\n" for line in text.splitlines()),
                         "lacks the column(s) rmse_std_deg"),
@@ -238,3 +250,44 @@ def test_the_committed_prediction_is_the_current_table_of_docs_prediction_md():
     for key, c in committed.items():
         assert shown[key] == [f"{c['mean']:.2f}", f"{c['p10']:.2f}", shown[key][2], f"{c['p90']:.2f}",
                               f"{min(c['members']):.2f}-{max(c['members']):.2f}", str(c["stalled"])], key
+
+
+def test_only_a_prediction_on_record_is_scored_unless_told_and_then_every_output_says_so(tmp_path, capsys, monkeypatch):
+    """The packaged files are the sixth prediction's, byte for byte; a file changed since (here one digit of the
+    third decimal, which the 2-decimal tables of docs/prediction.md cannot see) is refused, or scored and marked."""
+    assert score.registration() == score.REGISTERED[0]
+    for folder in ("ninth_refit_prediction", "trial_air_box"):
+        assert score.registration(ROOT / "examples" / folder) in score.REGISTERED[1:]
+    changed = tmp_path / "data"
+    changed.mkdir()
+    for name in score.COMMITTED_FILES:
+        (changed / name).write_bytes((score.COMMITTED / name).read_bytes())
+    cells = (changed / score.COMMITTED_FILES[0]).read_text()
+    first = cells.splitlines()[1]
+    number = next(field for field in first.split(",") if "." in field and len(field.split(".")[1]) > 3)
+    edited = number[:-1] + ("1" if number[-1] != "1" else "2")
+    (changed / score.COMMITTED_FILES[0]).write_text(cells.replace(first, first.replace(number, edited, 1), 1))
+    monkeypatch.setattr(score, "COMMITTED", changed)
+    assert score.registration() is None
+    committed = score.read_prediction()
+    measured = write_measured(tmp_path / "t3.csv", made_up(mean=lambda c, g, o: committed[c, g, o]["mean"]))
+    out = tmp_path / "s"
+    assert main(["score", "--measured", str(measured), "--out", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "is not a prediction on record before the T3 data" in err and err.count("\n") == 1 and not out.exists()
+    assert main(["score", "--measured", str(measured), "--unregistered", "--out", str(out)]) == 0
+    text = (out / "score.md").read_text(encoding="utf-8")
+    assert "**NOT a prediction on record before the data**" in text
+    assert "NOT a prediction on record before the data: 12 of 12 T3 cells within 20 %" in text
+
+
+def test_the_table_prints_what_its_verdicts_read():
+    """A measured mean equal to the band's end at 2 decimals but outside it unrounded reads 'no' beside a band
+    printed to 3 decimals, so the table does not contradict itself."""
+    p = predicted(mean=lambda c, g, o: 2.3)
+    p[CELLS[0]]["p90"] = 2.379  # 2.38 at 2 decimals
+    s = score.score(measured_of(made_up(mean=lambda c, g, o: 2.38)), p)
+    row = s["cells"][0]
+    assert not row["in_band"] and f"{row['band_p90']:.2f}" == f"{row['measured']:.2f}"
+    text = score.report(s, prediction="made up", measured="made up")
+    assert "| FF + PVA 0 g horizontal | 2.38 ± 0.1 | 2.300 | x0.966 | yes | 2.116-2.379 | no |" in text

@@ -3,9 +3,12 @@ cells, by rules written down on 2026-11-26, before any T3 measurement was seen.
 
 The prediction is the committed one (``data/t3_prediction.csv`` and ``data/t3_prediction_members.csv`` beside
 this module: ``twin validate``'s ``prediction.csv`` and ``prediction_members.csv`` on the committed as-built
-preset), or the one in a ``twin validate`` output folder (``--prediction DIR``). The measurements are a CSV
-with one row per T3 cell, twelve in all (:data:`MEASURED_COLUMNS`; ``trajectory``, ``runs`` and
-``stalled_runs`` may be left out: T3, five runs, not stated)::
+preset), or the one in a ``twin validate`` output folder (``--prediction DIR``). Either must be a prediction
+on record before the data (:data:`REGISTERED`, by its files' SHA-256): a file changed since, or a refit's new
+prediction, is refused unless ``--unregistered`` is given, and then every output says it is not on record.
+The measurements are a CSV with one row per T3 cell, twelve in all (:data:`MEASURED_COLUMNS`; ``trajectory``,
+``runs`` and ``stalled_runs`` may be left out: T3, five runs, not stated; ``stalled_runs`` on every row or on
+none; no other column)::
 
     controller,payload_g,orientation,rmse_mean_deg,rmse_std_deg
     smc,13.5,vertical,3.1,0.4
@@ -19,7 +22,9 @@ The rules (:func:`score`). Changing one after a measurement has been seen is a n
   20 % (the tolerance of every measured RMSE in ``twin validate``); ``in_band`` when the measured mean lies in
   the ensemble's 10-90 % band; ``in_members`` when it lies in the members' range (lowest to highest member
   mean); ``z``, the committed mean's distance from the measured mean in the measured mean's standard errors
-  (std / sqrt(runs)).
+  (std / sqrt(runs)). Each is judged on the numbers as given and computed, unrounded (``score.md`` prints
+  them to 3 decimals so that a verdict can be read off its table; added 2026-11-27, before any T3
+  measurement was seen, after a review found a 2-decimal table that read "in" beside a "no").
 * Per payload and orientation: which controller tracked better, measured and predicted (the committed
   means), or neither when the two means are equal; the measured order is **a toss** when the two measured
   means differ by less than two combined standard errors (or are equal). Right: the same answer.
@@ -34,6 +39,8 @@ from __future__ import annotations
 
 import argparse
 import csv
+import dataclasses
+import hashlib
 import importlib.resources
 import math
 import pathlib
@@ -53,6 +60,7 @@ from twin.experiments.validate import (
     rmse_within,
 )
 from twin.experiments.validate import SEEDS as VALIDATE_SEEDS
+from twin.physics.params import GearParams, SensorParams
 from twin.sim.scenario import CONTROLLER_LABELS
 
 COMMITTED = importlib.resources.files("twin.experiments") / "data"  # package data
@@ -60,13 +68,45 @@ COMMITTED_FILES = ("t3_prediction.csv", "t3_prediction_members.csv")
 VALIDATE_FILES = ("prediction.csv", "prediction_members.csv")  # the same two, as `twin validate` names them
 RULES_WRITTEN = "2026-11-26"  # before any T3 measurement was seen
 MEASURED_COLUMNS = ("controller", "payload_g", "orientation", "rmse_mean_deg", "rmse_std_deg")
+OPTIONAL_COLUMNS = ("trajectory", "runs", "stalled_runs")  # the measured file may give these too, nothing else
 MAX_RUNS = 1000  # runs per measured cell: more is a typing error, not a rig's day (left out: the thesis's five)
-SMALLEST_MEAN_DEG = 0.01  # a measured RMSE mean below this is no measurement (the Hall sensor's noise is 0.24 deg)
+# A measured RMSE below the Hall sensor's noise bound (0.02 mm of rack, 0.24 deg; SPEC §5) is no measurement of
+# this rig (most likely radians); above half a turn, none either (the joint's range is 180 deg).
+SMALLEST_MEAN_DEG = math.degrees(SensorParams().position_noise / GearParams().spur_radius)
+LARGEST_DEG = 180.0
+
+
+@dataclasses.dataclass(frozen=True)
+class Registration:
+    """A blind T3 prediction on record before any T3 measurement was seen: its two files' SHA-256 (the
+    cells', then the members'), as ``twin validate`` wrote them."""
+
+    name: str  # how score.md names it
+    registered: str  # the date it was put on record
+    preset: str  # the as-built preset digest it was run on (twin.plants.as_built.preset_digest)
+    cells_sha256: str
+    members_sha256: str
+
+
+# Every prediction `twin score` scores without --unregistered. A refit's new prediction is added here, dated, only
+# while no T3 measurement has been seen; the test holds the packaged files to the first entry.
+REGISTERED = (
+    Registration("the sixth blind prediction (the tenth refit's; the committed one)", "2026-11-27", "1c2dcd8c9f7f",
+                 "aa932337bc6b2b5cbe920d14f1e46eb0f1955785740ec3371327bcd43b3d9765",
+                 "32a6f6bce0291874960e0c1930f1bb583640573622aa0ae3cc85bb0c5e3ede8b"),
+    Registration("the fifth blind prediction (the ninth refit's; examples/ninth_refit_prediction)", "2026-11-26",
+                 "57ff10bf5b36", "4ca2fdca0a4787d6160e019683c8ce61155b0cf091b73cc28d26e35b3089c344",
+                 "28fd859f4e2881dc5f83e518ec09c3349ac275a3a128c23edd07060447ae3e2a"),
+    Registration("the air-box trial's prediction (examples/trial_air_box)", "2026-11-27", "3da50147f0ac",
+                 "9a133fe747948cb0f2e545f1cfb91eb747337ec1cdcf50c050ae0803b764ea8f",
+                 "37fe7c0cde01d1201163677fc6df1d5b2f16228b36ead834fa8185c0a122bcb5"),
+)
 TIE = "tie"  # the two means equal: neither tracked better (and the order is a toss)
 ORDER_LABELS = {**CONTROLLER_LABELS, TIE: "neither (equal means)"}
 TOSS_SE = 2.0  # measured means closer than this many combined standard errors: the order is a toss
 SCORE_COLUMNS = ("controller", "payload_g", "orientation", "measured", "measured_std", "runs", "twin_mean",
-                 "band_p10", "band_p90", "member_low", "member_high", "ratio", "within", "in_band", "in_members", "z")
+                 "band_p10", "band_p90", "member_low", "member_high", "ratio", "within", "in_band", "in_members", "z",
+                 "measured_stalled_runs", "twin_stalled_runs", "twin_runs")
 ORDER_COLUMNS = ("payload_g", "orientation", "measured_better", "measured_toss", "predicted_better", "right")
 CONTROLLER_NAMES = {**{name: name for name in CONTROLLER_LABELS}, **{label.lower(): name for name, label in
                                                                       CONTROLLER_LABELS.items()}}
@@ -100,15 +140,17 @@ def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
         raise InvalidScenario(f"cannot read {what} {str(path)!r}: {error}".splitlines()[0]) from None
 
 
-def _number(text: str, where: str, column: str, *, low: float = 0.0) -> float:
-    """``text`` as a finite number of at least ``low``, else a one-line error."""
+def _number(text: str, where: str, column: str, *, low: float = 0.0, high: float = math.inf,
+            hint: str = "") -> float:
+    """``text`` as a finite number from ``low`` to ``high``, else a one-line error (ending in ``hint``)."""
     try:
         value = float(text) if "_" not in text else math.nan
     except ValueError:
         value = math.nan
-    if not math.isfinite(value) or value < low:
-        bound = "a finite number" if low == -math.inf else f"a number of at least {low:g}"
-        raise InvalidScenario(f"{where}: {column} must be {bound}, got {text!r}")
+    if not math.isfinite(value) or not low <= value <= high:
+        bound = ("a finite number" if low == -math.inf else f"a number of at least {low:g}" if high == math.inf
+                 else f"a number from {low:.3g} to {high:g}")
+        raise InvalidScenario(f"{where}: {column} must be {bound}, got {text!r}{hint}")
     return value
 
 
@@ -161,14 +203,27 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
         hint = " (its fields must be separated by commas)" if any(";" in c or "\t" in c for c in columns) else ""
         raise InvalidScenario(f"measured file {str(path)!r} lacks the column(s) {', '.join(lacking)} "
                               f"(it needs {', '.join(MEASURED_COLUMNS)}){hint}")
+    unknown = [c for c in columns if c not in MEASURED_COLUMNS + OPTIONAL_COLUMNS]
+    if unknown:
+        raise InvalidScenario(f"measured file {str(path)!r} has the column(s) {', '.join(unknown)}, which are not "
+                              f"read (it takes {', '.join(MEASURED_COLUMNS)}; optional: {', '.join(OPTIONAL_COLUMNS)})")
     found: dict[tuple, dict] = {}
+    degrees = (f" (degrees, from the Hall sensor's noise, {SMALLEST_MEAN_DEG:.2f}, to half a turn; radians "
+               f"would be about 57 times smaller)")
     for where, key, row in _each_cell(rows, path, found):
         runs = _whole(row.get("runs") or str(THESIS_RUNS), where, "runs", 2, MAX_RUNS)
         stalled = row.get("stalled_runs") or None
-        found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG),
-                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg"), "runs": runs,
+        found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG,
+                                      high=LARGEST_DEG, hint=degrees),
+                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg", high=LARGEST_DEG), "runs": runs,
                       "stalled": None if stalled is None else _whole(stalled, where, "stalled_runs", 0, runs)}
     _complete(found, f"measured file {str(path)!r}")
+    given = [key for key, cell in found.items() if cell["stalled"] is not None]
+    if given and len(given) != len(found):
+        blank = next(f"{CONTROLLER_LABELS[c]} {g:g} g {o}" for (c, g, o), cell in found.items()
+                     if cell["stalled"] is None)
+        raise InvalidScenario(f"measured file {str(path)!r} gives stalled_runs on {len(given)} of the 12 cells "
+                              f"(not on {blank}): give it on every cell or on none")
     return found
 
 
@@ -181,9 +236,20 @@ def prediction_files(folder: pathlib.Path | None) -> tuple:
     return tuple(folder / name for name in VALIDATE_FILES)
 
 
+def registration(folder: pathlib.Path | None = None) -> Registration | None:
+    """The :data:`REGISTERED` prediction whose two files ``folder``'s are, byte for byte (the committed ones by
+    default), or None. A file that cannot be read is left to :func:`read_prediction` to name."""
+    try:
+        digests = tuple(hashlib.sha256(path.read_bytes()).hexdigest() for path in prediction_files(folder))
+    except OSError:
+        return None
+    return next((r for r in REGISTERED if (r.cells_sha256, r.members_sha256) == digests), None)
+
+
 def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
     """The prediction by (controller, payload g, orientation): the committed mean, the 10-90 % band, every
-    member's mean, the stalled runs and the runs they are of (every member's)."""
+    member's mean, the stalled runs and the runs they are of (every member's). Whether it is on record is
+    :func:`registration`'s question."""
     cells_path, members_path = prediction_files(folder)
     columns, rows = _read(cells_path, "prediction file")
     member_columns, member_rows = _read(members_path, "prediction file")
@@ -246,7 +312,8 @@ def score(measured: dict[tuple, dict], predicted: dict[tuple, dict]) -> dict:
                       "ratio": ratio, "within": bool(rmse_within(p["mean"], m["mean"])),
                       "in_band": p["p10"] <= m["mean"] <= p["p90"],
                       "in_members": low <= m["mean"] <= high,
-                      "z": _in_standard_errors(p["mean"] - m["mean"], se)})
+                      "z": _in_standard_errors(p["mean"] - m["mean"], se), "measured_stalled_runs": m["stalled"],
+                      "twin_stalled_runs": p["stalled"], "twin_runs": p["runs"]})
     orders = []
     for payload_g, orientation in dict.fromkeys((g, o) for _, g, o in CELL_KEYS):
         ff, smc = measured["ffpva", payload_g, orientation], measured["smc", payload_g, orientation]
@@ -287,11 +354,17 @@ def _fitted_note() -> str:
             "which `twin calibrate` fitted. The other ten were predicted before any was seen.")
 
 
+def _stalls(row: dict) -> str:
+    measured = ("not given" if row["measured_stalled_runs"] is None else
+                f"{row['measured_stalled_runs']} of {row['runs']}")
+    return f"{measured}, {row['twin_stalled_runs']} of {row['twin_runs']}"
+
+
 def answer(s: dict) -> str:
-    """One line: how the prediction fared."""
+    """One line: how the prediction fared (first saying so when it is not on record)."""
     cells, orders = s["cells"], s["orders"]
     c3 = s["conclusions"][3]
-    return (f"{sum(r['within'] for r in cells)} of {len(cells)} T3 cells within {RMSE_TOLERANCE * 100:.0f} % of the measured "
+    return (("NOT a prediction on record before the data: " if not s.get("registered", True) else "") + f"{sum(r['within'] for r in cells)} of {len(cells)} T3 cells within {RMSE_TOLERANCE * 100:.0f} % of the measured "
             f"mean; {sum(r['in_band'] for r in cells)} inside the 10-90 % band, {sum(r['in_members'] for r in cells)} "
             f"inside the members' range; controller order right in {sum(o['right'] for o in orders)} of "
             f"{len(orders)} pairs ({sum(o['measured_toss'] for o in orders)} a toss on the measured runs); sliding "
@@ -306,16 +379,21 @@ def report(s: dict, *, prediction: str, measured: str) -> str:
         f"{RULES_WRITTEN}, before any T3 measurement was seen (twin/experiments/score.py). Degrees.", "",
         "## Summary", "", answer(s), "", _fitted_note(), "",
         "## Per cell", "",
-        "`within`: the committed preset's mean within 20 % of the measured mean. `z`: how far it is from the "
-        "measured mean, in the measured mean's standard errors (std / sqrt(runs)).", "",
-        "| cell | measured | committed | ratio | within | band p10-p90 | in band | members | in members | z |",
-        "|---|---|---|---|---|---|---|---|---|---|"]
+        f"`ratio`: the committed preset's mean over the measured mean (above 1: the twin predicted a larger error). "
+        f"`within`: that ratio within {RMSE_TOLERANCE * 100:.0f} % of 1. `in band`: the measured mean inside the "
+        "ensemble's 10-90 % band; `in members`: inside the members' range (lowest to highest member mean). `z`: "
+        "the committed mean less the measured mean, in the measured mean's standard errors (std / sqrt(runs)); "
+        "positive: the twin predicted a larger error. Every verdict is on the unrounded numbers; the twin's are "
+        "printed to 3 decimals so that each verdict can be read off the table.", "",
+        "| cell | measured | committed | ratio | within | band p10-p90 | in band | members | in members | z | "
+        "stalled runs: measured, twin |",
+        "|---|---|---|---|---|---|---|---|---|---|---|"]
     yes = {True: "yes", False: "no"}
     for r in s["cells"]:
-        lines.append(f"| {_cell_name(r)} | {r['measured']:.2f} ± {r['measured_std']:.2f} | {r['twin_mean']:.2f} | "
-                     f"x{r['ratio']:.2f} | {yes[r['within']]} | {r['band_p10']:.2f}-{r['band_p90']:.2f} | "
-                     f"{yes[r['in_band']]} | {r['member_low']:.2f}-{r['member_high']:.2f} | {yes[r['in_members']]} | "
-                     f"{r['z']:+.1f} |")
+        lines.append(f"| {_cell_name(r)} | {r['measured']:g} ± {r['measured_std']:g} | {r['twin_mean']:.3f} | "
+                     f"x{r['ratio']:.3f} | {yes[r['within']]} | {r['band_p10']:.3f}-{r['band_p90']:.3f} | "
+                     f"{yes[r['in_band']]} | {r['member_low']:.3f}-{r['member_high']:.3f} | {yes[r['in_members']]} | "
+                     f"{r['z']:+.1f} | {_stalls(r)} |")
     lines += ["", "## Which controller tracked better", "",
               f"A toss: the measured means differ by less than {TOSS_SE:g} combined standard errors.", "",
               "| payload | orientation | measured | predicted | right |", "|---|---|---|---|---|"]
@@ -334,21 +412,23 @@ def report(s: dict, *, prediction: str, measured: str) -> str:
                                (2, "13.5 g vertical over 0 g vertical", stalls)):
         parts = [f"{CONTROLLER_LABELS[name]} measured x{c[number][name]['measured']:.2f}, predicted "
                  f"x{c[number][name]['predicted']:.2f} ({'agrees' if c[number][name]['agree'] else 'does not agree'}"
-                 f" within 20 %)" for name in ("ffpva", "smc")]
+                 f" within {RMSE_TOLERANCE * 100:.0f} %)" for name in ("ffpva", "smc")]
         lines.append(f"{number}. *{text}*: " + "; ".join(parts) + more + ".")
+    tosses = sum(o["measured_toss"] and o["measured_better"] == "smc" for o in s["orders"])
+    of_them = f" ({tosses} of them a toss on the measured runs)" if tosses else ""
     lines.append(f"3. *Sliding mode tracks better than FF + PVA*: in {c[3]['measured']} of {c[3]['of']} pairs "
-                 f"measured, {c[3]['predicted']} predicted.")
+                 f"measured{of_them}, {c[3]['predicted']} predicted.")
     return "\n".join(lines) + "\n"
 
 
 def figure(s: dict, path: pathlib.Path) -> None:
     """Each cell: the members' range (thin), the 10-90 % band (thick), the committed mean (dot) and the
-    measured mean with two standard errors."""
+    measured mean with two standard errors; the legend outside the axes, so that it hides no cell."""
     from viz.figures import finish, plt
 
     cells = s["cells"]
     x = np.arange(len(cells))
-    fig, ax = plt.subplots(figsize=(9, 4.2))
+    fig, ax = plt.subplots(figsize=(11, 4.2))
     ax.vlines(x, [r["member_low"] for r in cells], [r["member_high"] for r in cells], color="tab:blue", lw=1,
               label="members' range")
     ax.vlines(x, [r["band_p10"] for r in cells], [r["band_p90"] for r in cells], color="tab:blue", lw=6, alpha=0.4,
@@ -359,16 +439,25 @@ def figure(s: dict, path: pathlib.Path) -> None:
                 capsize=3, label="measured ± 2 SE")
     ax.set_xticks(x, [f"{'FF+PVA' if r['controller'] == 'ffpva' else 'SMC'}\n{r['payload_g']:g} g "
                       f"{r['orientation'][0].upper()}" for r in cells], fontsize=8)
-    ax.set_title("Blind T3 prediction against the measurements")
-    fig.subplots_adjust(bottom=0.2)  # room for the two-line cell names and the axis label
-    finish(fig, ax, path, xlabel="T3 cell", ylabel="RMSE (deg)")
+    ax.set_title(f"{s.get('short_name', 'Blind T3 prediction')} against the measurements", fontsize=10)
+    fig.subplots_adjust(bottom=0.2, right=0.8)  # room for the two-line cell names and the legend
+    finish(fig, ax, path, xlabel="T3 cell", ylabel="RMSE (deg)",
+           legend_at={"loc": "upper left", "bbox_to_anchor": (1.01, 1.0)})
 
 
-def committed_name() -> str:
-    """How ``score.md`` names the committed prediction: with the preset it was run on."""
+def prediction_name(record: Registration | None, folder: pathlib.Path | None) -> str:
+    """How ``score.md`` names the prediction it scores: the registration's name, date and preset (and the
+    committed preset, if that has changed since), or that it is not on record."""
     from twin.plants.as_built import preset_digest
 
-    return f"the committed one, `twin validate` on as-built preset {preset_digest()}"
+    where = "the package's `twin/experiments/data/`" if folder is None else f"`{folder}`"
+    if record is None:
+        return (f"**NOT a prediction on record before the data** ({where}; scored with --unregistered: its files "
+                "match no registered prediction's)")
+    now = preset_digest()
+    preset = (f"as-built preset {record.preset}" if now == record.preset else
+              f"as-built preset {record.preset}; the committed preset is now {now}")
+    return f"{record.name}, registered {record.registered} ({where}; `twin validate` on {preset})"
 
 
 class ScoreExperiment(Experiment):
@@ -382,14 +471,25 @@ class ScoreExperiment(Experiment):
         parser.add_argument("--prediction", type=pathlib.Path, default=None, metavar="DIR",
                             help="a twin validate --out folder (default: the committed prediction)")
 
+        parser.add_argument("--unregistered", action="store_true",
+                            help="score a prediction that is not on record before the data (a refit's, a what-if's); "
+                                 "every output then says so")
+
     def check(self, args: argparse.Namespace) -> None:
         read_measured(args.measured)
         read_prediction(args.prediction)
+        if registration(args.prediction) is None and not args.unregistered:
+            which = ("the packaged prediction (twin/experiments/data/)" if args.prediction is None
+                     else f"--prediction {str(args.prediction)!r}")
+            raise InvalidScenario(f"{which} is not a prediction on record before the T3 data: its files match none "
+                                  "in twin/experiments/score.py's REGISTERED (--unregistered scores it, marked so)")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
         s = score(read_measured(args.measured), read_prediction(args.prediction))
-        s["report"] = report(s, measured=f"`{args.measured}`",
-                             prediction=committed_name() if args.prediction is None else f"`{args.prediction}`")
+        record = registration(args.prediction)
+        s["registered"] = record is not None
+        s["short_name"] = "Unregistered T3 prediction" if record is None else record.name.split(" (")[0].capitalize()
+        s["report"] = report(s, measured=f"`{args.measured}`", prediction=prediction_name(record, args.prediction))
         return Outcome(rows=s["cells"], answer=answer(s), detail=s)
 
     def file_names(self) -> tuple[str, ...]:
