@@ -1014,3 +1014,16 @@ def test_a_folder_in_the_way_of_an_output_file_is_refused_and_no_file_of_the_set
     assert _exit_code(["whatif", "gear-load", "--out", str(out)]) == 2
     _one_line_error(capsys, f"cannot write {out / 'gear-load.png'}: a folder is in the way of this file")
     assert [p.name for p in out.iterdir()] == ["gear-load.png"]
+
+
+@pytest.mark.parametrize("argv", [
+    ["run", "--controller", "smc", "--trajectory", "1", "--seed", "1" + "0" * 400],
+    ["demo", "--seeds", "1" + "0" * 400],
+    ["bench", "--batch", "9" * 5000],  # past Python's 4300-digit limit on int()
+])
+def test_an_integer_too_long_for_a_float_is_a_one_line_error(argv, capsys):
+    """math.isfinite(int) converts to float: a 401-digit seed overflowed it, a traceback (found 2026-11-27)."""
+    with pytest.raises(SystemExit) as stop:
+        main(argv)
+    assert stop.value.code == 2
+    _one_line_error(capsys, "got '")

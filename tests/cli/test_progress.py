@@ -130,3 +130,22 @@ def test_bench_shows_one_bar_with_its_total_and_labels_each_stage(monkeypatch, c
     assert "100%" in renders[-1] and f"{tqdm.format_sizeof(total)}{shown}" in renders[-1], renders[-1]
     stages = list(dict.fromkeys(re.findall(r"bench (\[\d/4\])", err)))
     assert stages == ["[1/4]", "[2/4]", "[3/4]", "[4/4]"]
+
+
+def test_a_resumed_sweeps_count_is_drawn_at_once():
+    """run_sweep counts what a resumed sweep had done in one call, at once; tqdm draws an update only after its
+    mininterval, so until the first batch ended a resumed study showed 0 of N (found 2026-11-27). counting()
+    redraws at each count; the sweep, the robustness study and the payload what-if use it."""
+    from twin.batch.sweep import counting
+
+    calls = []
+
+    class Bar:
+        def update(self, n):
+            calls.append(("update", n))
+
+        def refresh(self):
+            calls.append(("refresh",))
+
+    counting(Bar())(232)
+    assert calls == [("update", 232), ("refresh",)]

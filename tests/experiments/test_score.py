@@ -142,6 +142,7 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
      "gives stalled_runs on 1 of the 12 cells (not on FF + PVA 6.5 g horizontal): give it on every cell or on none"),
     (lambda rows: [{**rows[0], "runs": "1"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000, got '1'"),
     (lambda rows: [{**rows[0], "runs": "\u00b2"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000"),
+    (lambda rows: [{**rows[0], "runs": "1" + "0" * 5000}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000"),
     (lambda rows: [{**rows[0], "stalled_runs": "6"}, *rows[1:]], "line 2: stalled_runs must be a whole number from 0 to 5"),
     (lambda rows: [{**rows[0], "trajectory": "1"}, *rows[1:]], "line 2: only the T3 cells are scored, got trajectory '1'"),
 ])
@@ -161,6 +162,8 @@ def test_missing_inputs_and_malformed_files_are_one_line_errors(tmp_path, capsys
     text = good.read_text()
     header, first, *rest = text.splitlines(keepends=True)
     cases = {
+        # Not a table of twelve cells, and read no further (/dev/zero would never end).
+        "huge.csv": (text + "," * score.MAX_BYTES, "is over 1 MB: not a table of T3 cells"),
         # A misspelt optional column would be read as not given (five runs, no stalls): refused instead.
         "misspelt.csv": (header.rstrip("\n") + ",n_runs\n" + "".join(line.rstrip("\n") + ",10\n"
                                                                        for line in [first, *rest]),
@@ -223,7 +226,10 @@ def test_a_validate_folder_can_be_scored_in_place_of_the_committed_prediction(tm
     # A broken folder is a one-line error, not a score.
     cells, members = (folder / "prediction.csv").read_text(), (folder / "prediction_members.csv").read_text()
     for name, content, message in (
-            ("prediction.csv", cells.replace(",2.0,1.9,", ",nan,1.9,", 1), "twin_mean must be a finite number, got 'nan'"),
+            ("prediction.csv", cells.replace(",2.0,1.9,", ",nan,1.9,", 1), "twin_mean must be a number from 0.241 to 180, got 'nan'"),
+            # A zero RMSE would divide by zero in a payload's cost.
+            ("prediction.csv", cells.replace(",2.0,1.9,", ",0,1.9,", 1), "twin_mean must be a number from 0.241 to 180, got '0'"),
+            ("prediction_members.csv", members.replace(",1.8", ",-1.8", 1), "twin_mean must be a number from 0.241"),
             ("prediction_members.csv", members.replace(",1,", ",0,", 1), "member 0 of the cell is given twice"),
             ("prediction_members.csv", "".join(members.splitlines(keepends=True)[:-1]),
              "does not give every T3 cell the same members")):

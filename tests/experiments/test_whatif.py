@@ -231,6 +231,24 @@ def test_smc_phi_changes_phi_alone_and_reports_against_the_measurements():
     assert "On the rig sliding mode was ahead of FF + PVA on 9 of 9." in outcome.answer
 
 
+def test_a_phi_too_small_for_the_closed_form_lag_has_none_not_a_traceback():
+    """At phi = 0.01 m/s the switching term saturates before the valve opens: the lag has no closed form. The
+    what-if accepts phis down to 0; it crashed after its runs (found 2026-11-27). Now that law's lag is NaN."""
+    import dataclasses
+
+    import controllers
+    from twin.envs.runner import nominal_model
+    from twin.experiments import validate
+    from twin.plants import plant
+
+    base = plant("as-built")
+    nominal = nominal_model(base)
+    thesis = controllers.make_controller("smc", nominal=nominal, gain_set=base.gain_set, tick=base.timestep)
+    small = dataclasses.replace(thesis, gains=dataclasses.replace(thesis.gains, boundary_layer=0.01))
+    lags = validate.ramp_opening_lags(base, nominal, {"thesis": thesis, "small": small})["lag_deg"]
+    assert math.isnan(lags["small"]) and 0 < lags["thesis"] < 10
+
+
 def test_smc_phi_answer_counts_the_cells_within_tolerance_and_ahead():
     """Made-up rows: a ratio of exactly 1.2 is within; 'ahead' compares with FF + PVA per cell; a phi at which some
     cell is out is not named; no lag (nan) is not printed."""

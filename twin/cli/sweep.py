@@ -67,15 +67,14 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
     from tqdm import tqdm
 
     from twin.batch import tables
-    from twin.batch.sweep import open_store, run_sweep
+    from twin.batch.sweep import counting, open_store, run_sweep
 
     open_store(args.out).close()  # refuses a store of another code version before any output
     print(f"{len(points)} scenario{'' if len(points) == 1 else 's'} -> {args.out.resolve()}", file=sys.stderr)
-    # refreshed at each count, so a resumed sweep shows what was done before at once, not at its next batch
     bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
     try:
         outcome = run_sweep(points, out=args.out, workers=args.workers, backend=args.backend,
-                            address=args.ray_address, progress=lambda n: (bar.update(n), bar.refresh()))
+                            address=args.ray_address, progress=counting(bar))
     except KeyboardInterrupt:
         bar.close()
         print(f"interrupted: finished scenarios are kept in {args.out / 'results.sqlite'}; "

@@ -50,9 +50,10 @@ def checked(kind: type, accept, requirement: str):
     def parse(text: str):
         try:
             value = kind(text)
-        except ValueError:
+        except ValueError:  # not a number; or an integer of over 4300 digits
             value = None
-        if value is None or not math.isfinite(value) or not accept(value):
+        # An int is always finite, and too long a one would overflow math.isfinite's float.
+        if value is None or (isinstance(value, float) and not math.isfinite(value)) or not accept(value):
             raise argparse.ArgumentTypeError(f"{requirement}, got {text!r}")
         return value
 

@@ -42,6 +42,7 @@ import csv
 import dataclasses
 import hashlib
 import importlib.resources
+import io
 import math
 import pathlib
 
@@ -69,6 +70,7 @@ VALIDATE_FILES = ("prediction.csv", "prediction_members.csv")  # the same two, a
 RULES_WRITTEN = "2026-11-26"  # before any T3 measurement was seen
 MEASURED_COLUMNS = ("controller", "payload_g", "orientation", "rmse_mean_deg", "rmse_std_deg")
 OPTIONAL_COLUMNS = ("trajectory", "runs", "stalled_runs")  # the measured file may give these too, nothing else
+MAX_BYTES = 1_000_000  # a file of twelve cells is under 1 kB; past this it is the wrong file (or /dev/zero)
 MAX_RUNS = 1000  # runs per measured cell: more is a typing error, not a rig's day (left out: the thesis's five)
 # A measured RMSE below the Hall sensor's noise bound (0.02 mm of rack, 0.24 deg; SPEC §5) is no measurement of
 # this rig (most likely radians); above half a turn, none either (the joint's range is 180 deg).
@@ -115,23 +117,26 @@ CELL_KEYS = tuple((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # (controller, 
 
 def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
     """A CSV's column names and its rows, each with the line it ends on; blank rows left out. One-line
-    :class:`InvalidScenario` errors for a file that cannot be read, a repeated column name or a row with more
-    fields than the header. ``path`` may be a package resource."""
+    :class:`InvalidScenario` errors for a file that cannot be read or is over :data:`MAX_BYTES`, a repeated
+    column name or a row with more fields than the header. ``path`` may be a package resource."""
     try:
         with importlib.resources.as_file(path) as real, open(real, newline="", encoding="utf-8-sig") as handle:
-            reader = csv.DictReader(handle)
-            columns = [c.strip() for c in reader.fieldnames or []]
-            repeated = sorted({c for c in columns if columns.count(c) > 1})
-            if repeated:
-                raise InvalidScenario(f"{what} {str(path)!r} names the column(s) {', '.join(repeated)} more than once")
-            rows = []
-            for row in reader:
-                if None in row:
-                    raise InvalidScenario(f"{what} {str(path)!r} line {reader.line_num} has more fields than its header")
-                cells = {k.strip(): (v or "").strip() for k, v in row.items()}
-                if any(cells.values()):
-                    rows.append((reader.line_num, cells))
-            return columns, rows
+            text = handle.read(MAX_BYTES + 1)
+        if len(text) > MAX_BYTES:
+            raise InvalidScenario(f"{what} {str(path)!r} is over {MAX_BYTES // 1_000_000} MB: not a table of T3 cells")
+        reader = csv.DictReader(io.StringIO(text, newline=""))
+        columns = [c.strip() for c in reader.fieldnames or []]
+        repeated = sorted({c for c in columns if columns.count(c) > 1})
+        if repeated:
+            raise InvalidScenario(f"{what} {str(path)!r} names the column(s) {', '.join(repeated)} more than once")
+        rows = []
+        for row in reader:
+            if None in row:
+                raise InvalidScenario(f"{what} {str(path)!r} line {reader.line_num} has more fields than its header")
+            cells = {k.strip(): (v or "").strip() for k, v in row.items()}
+            if any(cells.values()):
+                rows.append((reader.line_num, cells))
+        return columns, rows
     except FileNotFoundError:
         raise InvalidScenario(f"{what} {str(path)!r} does not exist") from None
     except IsADirectoryError:
@@ -156,7 +161,7 @@ def _number(text: str, where: str, column: str, *, low: float = 0.0, high: float
 
 def _whole(text: str, where: str, column: str, low: int, high: int) -> int:
     """``text`` as a whole number from ``low`` to ``high``, else a one-line error."""
-    if not (text.isascii() and text.isdigit()) or not low <= int(text) <= high:
+    if not (text.isascii() and text.isdigit()) or len(text.lstrip("0")) > len(str(high)) or not low <= int(text) <= high:
         raise InvalidScenario(f"{where}: {column} must be a whole number from {low} to {high}, got {text!r}")
     return int(text)
 
@@ -257,8 +262,8 @@ def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
         raise InvalidScenario(f"{str(cells_path)!r} and {str(members_path)!r} are not twin validate's prediction files")
     found: dict[tuple, dict] = {}
     for where, key, row in _each_cell(rows, cells_path, found):
-        found[key] = {**{name: _number(row[column], where, column, low=-math.inf) for name, column in (
-            ("mean", "twin_mean"), ("p10", "band_p10"), ("p90", "band_p90"))},
+        found[key] = {**{name: _number(row[column], where, column, low=SMALLEST_MEAN_DEG, high=LARGEST_DEG)
+                         for name, column in (("mean", "twin_mean"), ("p10", "band_p10"), ("p90", "band_p90"))},
             "stalled": _whole(row["stalled_runs"], where, "stalled_runs", 0, 10**9), "members": {}}
     for line, row in member_rows:
         where = f"{members_path.name} line {line}"
@@ -269,7 +274,7 @@ def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
         members = found[key]["members"]
         if member in members:
             raise InvalidScenario(f"{where}: member {member} of the cell is given twice")
-        members[member] = _number(row["twin_mean"], where, "twin_mean", low=-math.inf)
+        members[member] = _number(row["twin_mean"], where, "twin_mean", low=SMALLEST_MEAN_DEG, high=LARGEST_DEG)
     _complete(found, f"prediction {str(cells_path.parent)!r}")
     counts = {len(cell["members"]) for cell in found.values()}
     if len(counts) != 1 or 0 in counts:

@@ -580,8 +580,9 @@ def opening_lag(controller, nominal, position, speed: float, *, ticks_to_open: i
 
 def ramp_opening_lags(plant, nominal, laws: dict) -> dict:
     """Per law in ``laws`` (name -> controller), the closed-form :func:`opening_lag` on T2 (deg, the median over
-    the ramp's reference) on ``plant``'s solenoid valve; also ``"opening_pct"``, the held command whose pulse
-    opens that valve, and ``"feedforward_pct"``, the ramp's feed-forward duty (lowest, highest)."""
+    the ramp's reference) on ``plant``'s solenoid valve, NaN for a law it has no closed form for (a sliding mode
+    whose switching term saturates before the valve opens: a small phi); also ``"opening_pct"``, the held command
+    whose pulse opens that valve, and ``"feedforward_pct"``, the ramp's feed-forward duty (lowest, highest)."""
     from controllers.feedforward import feedforward_duty
     from twin.physics.ticks import whole_ticks
     from twin.physics.trajectories import RAMP_SPEED, trajectory
@@ -592,9 +593,14 @@ def ramp_opening_lags(plant, nominal, laws: dict) -> dict:
     ramp = trajectory(2, spur_radius=radius)
     positions = ramp.sample(np.arange(0.0, ramp.duration, plant.timestep), radius).position
     u_ff = feedforward_duty(nominal, positions, np.full(positions.shape, RAMP_SPEED), np.zeros(positions.shape))
-    lags = {name: math.degrees(float(np.median(opening_lag(
-        law, nominal, positions, RAMP_SPEED, ticks_to_open=n_open, period_ticks=period_ticks, tick=plant.timestep)))
-        / radius) for name, law in laws.items()}
+    def lag(law) -> float:
+        try:
+            return math.degrees(float(np.median(opening_lag(law, nominal, positions, RAMP_SPEED, ticks_to_open=n_open,
+                                                            period_ticks=period_ticks, tick=plant.timestep))) / radius)
+        except ValueError:  # saturated: no closed form
+            return math.nan
+
+    lags = {name: lag(law) for name, law in laws.items()}
     return {"lag_deg": lags, "opening_pct": opening_command(n_open, period_ticks),
             "feedforward_pct": (float(u_ff.min()), float(u_ff.max()))}
 

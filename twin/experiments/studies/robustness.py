@@ -21,7 +21,7 @@ import numpy as np
 from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from twin.batch.grid import GridPoint, expand
-from twin.batch.sweep import run_sweep
+from twin.batch.sweep import counting, run_sweep
 from twin.batch.tables import signed, summarise, write_csv
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
@@ -278,7 +278,7 @@ class RobustnessStudyExperiment(Experiment):
         print(f"{len(points)} runs on the {args.plant} plant -> {out.resolve()}", file=sys.stderr)
         with tqdm(total=len(points), unit="run", file=sys.stderr, dynamic_ncols=True, desc="robustness") as bar:
             study = robustness_study(out=out, plant_name=args.plant, seeds=args.seeds, workers=args.workers,
-                                     progress=bar.update, ensemble=args.ensemble)
+                                     progress=counting(bar), ensemble=args.ensemble)
         return Outcome(rows=study.summary, answer=format_robustness(study), failed=len(study.failed), detail=study)
 
     def file_names(self) -> tuple[str, ...]:

@@ -10,7 +10,7 @@ import pathlib
 from collections.abc import Sequence
 
 from twin.batch.grid import expand
-from twin.batch.sweep import run_sweep
+from twin.batch.sweep import counting, run_sweep
 from twin.batch.tables import summarise
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome
@@ -30,7 +30,7 @@ def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory:
                      "orientation": list(ORIENTATIONS), "plant": [plant_name], "seed": list(range(seeds))})
     if bar is not None:
         bar.reset(total=len(points))
-    records = run_sweep(points, out=out, workers=workers, progress=None if bar is None else bar.update).records
+    records = run_sweep(points, out=out, workers=workers, progress=None if bar is None else counting(bar)).records
     rows = summarise(records)
     lines = []
     for controller in ("ffpva", "smc"):
