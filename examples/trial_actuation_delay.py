@@ -1,7 +1,7 @@
 """Trial (not installed): could a lag between the controller and the valves explain PVA + DZC's T1?
 
 The rig's PVA + DZC tracked T1 at 4.20 deg with a 13.5 deg largest error, and T2 and T3 at 2.93 and
-3.00; the twin's tracks T1 at about 1.7 deg and T2 and T3 within 8 % (docs/as-built.md). A laboratory
+3.00; the twin's tracks T1 at about 1.7 deg and T2 and T3 within 8 % (docs/investigations.md). A laboratory
 DAQ may put its outputs out some samples after it reads its inputs. The thesis gives no such lag, and
 the twin's loop has none: the duty computed from tick k's sample drives the coils from tick k on.
 
@@ -13,7 +13,7 @@ rig's, not of one law). It runs §8's eleven experimental cells on the ninth ref
 0-9, for each delay, and prints per cell the mean RMSE, the mean largest error and the ratio to the
 measured mean, then PVA + DZC's T1 error over the move and over the hold, its SSE ranges and how far
 off its runs end. With d = 0 the delayed runs are the plain runs to the last bit; the script checks
-that first. Nothing is refitted around the delay. The result is recorded in docs/as-built.md.
+that first. Nothing is refitted around the delay. The result is recorded in docs/investigations.md.
 
 (A first version of this trial delayed the duty at the controller instead. With the PWM period's phase
 fixed to the tick, that did not delay a 16 ms law's pulses, only cut or stretched their first ticks; a

@@ -21,7 +21,7 @@ it, and prints for each:
   ensemble's members all share the committed air fraction, so its band cannot show what the air does to them.
 
 Nothing is refitted around the moved value, and nothing here is installed: past the box is a diagnosis, not a
-fit. The result is recorded in docs/as-built.md (PVA T1 and the lag) and docs/prediction.md (the air and the T3
+fit. The result is recorded in docs/investigations.md (PVA T1 and the lag) and docs/prediction.md (the air and the T3
 cells, which the README sums up); a slow test in tests/experiments/test_trials.py holds the printed table.
 
     python examples/trial_chamber_buildup.py

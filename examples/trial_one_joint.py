@@ -18,7 +18,7 @@ allow (chi-square, 4 degrees of freedom, as validate's). Then, since the map tur
 the spread comes from, FF + PVA and sliding mode T1 (0 g flat) on the same seeds with the sensors'
 noise (Hall and pressure, uniform within the thesis's bounds) at 1, 0.25 and 0.05 of its size: the mean
 and std over the 40 runs of the RMSE and of the error when the move ends (1.0 s). The result is recorded
-in docs/as-built.md. Last, how much the blind T3 prediction's flat and 13.5 g vertical cells move with
+in docs/investigations.md. Last, how much the blind T3 prediction's flat and 13.5 g vertical cells move with
 the noise at 0.5, 1 and 1.73 of its size (1.73: uniform noise with the bound as its std, as a normal
 reading of "±0.02 mm" would give), seeds 40-59 (docs/prediction.md quotes it).
 
@@ -43,7 +43,7 @@ from twin.plants.as_built import STICTION_SCATTER, as_built_plant
 from twin.plants.preset import Plant
 from twin.sim.scenario import Scenario
 
-# The preset this script's numbers in docs/as-built.md were measured on: the eighth refit's values, kept beside
+# The preset this script's numbers in docs/investigations.md were measured on: the eighth refit's values, kept beside
 # the scripts since the ninth refit (2026-11-26) replaced it as the committed preset.
 EIGHTH_REFIT = json.loads(pathlib.Path(__file__).with_name("eighth_refit.json").read_text())["fitted"]
 

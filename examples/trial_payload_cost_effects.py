@@ -6,7 +6,7 @@ twin's FF + PVA x1.00, the rig's x1.25 (2026-11-26). This script runs both laws 
 horizontal, seeds 40-79, on the committed preset (the ninth refit's, ``twin/plants/data/ninth_refit.json``) as it is and with each effect switched off in turn
 (compressibility only with the supply line, which needs it), nothing refitted, and prints each cell's mean
 RMSE and the cost (13.5 g over 0 g) with its paired standard error. Its result (2026-11-26) is
-in docs/as-built.md.
+in docs/investigations.md.
 
     python examples/trial_payload_cost_effects.py
 """

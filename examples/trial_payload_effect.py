@@ -6,7 +6,7 @@ seeds 40-79, on the eighth refit). This script runs FF + PVA and sliding mode T1
 validate's "Five runs or 40" uses), at 0, 6.5 and 13.5 g, flat and on its side, and prints the RMS of the
 scored error (the Hall sensor's, as the RMSE) over the whole run, over the move (0-1 s), over the hold's
 first half second (1.0-1.5 s) and over the rest of the hold (1.5-3 s), the whole run's and the move's
-RMSE over 0 g flat, and the error when the move ends (1.0 s; mean and std over the runs). The result is recorded in docs/as-built.md.
+RMSE over 0 g flat, and the error when the move ends (1.0 s; mean and std over the runs). The result is recorded in docs/investigations.md.
 
     python examples/trial_payload_effect.py
 """
@@ -24,7 +24,7 @@ from twin.physics.model import Orientation
 from twin.plants.as_built import as_built_plant
 from twin.sim.scenario import Scenario
 
-# The preset this script's numbers in docs/as-built.md were measured on: the eighth refit's values, kept beside
+# The preset this script's numbers in docs/investigations.md were measured on: the eighth refit's values, kept beside
 # the scripts since the ninth refit (2026-11-26) replaced it as the committed preset.
 EIGHTH_REFIT = json.loads(pathlib.Path(__file__).with_name("eighth_refit.json").read_text())["fitted"]
 

@@ -21,7 +21,7 @@ rig's: ±0.41). It runs them:
 
 For the two valves it also prints sliding mode's T2 and T3 beside the committed valve's, since a valve that
 opens on shorter pulses could let sliding mode's switching term act sooner. Nothing is refitted around
-these changes: the calibrated values stay the eighth refit's. The result is recorded in docs/as-built.md.
+these changes: the calibrated values stay the eighth refit's. The result is recorded in docs/investigations.md.
 
     python examples/trial_pva_t1.py
 """
@@ -40,7 +40,7 @@ from twin.plants.as_built import as_built_plant
 from twin.plants.preset import Plant
 from twin.sim.scenario import Scenario
 
-# The preset this script's numbers in docs/as-built.md were measured on: the eighth refit's values, kept beside
+# The preset this script's numbers in docs/investigations.md were measured on: the eighth refit's values, kept beside
 # the scripts since the ninth refit (2026-11-26) replaced it as the committed preset.
 EIGHTH_REFIT = json.loads(pathlib.Path(__file__).with_name("eighth_refit.json").read_text())["fitted"]
 

@@ -5,7 +5,7 @@ rint(d x 16 / 100) ticks of the 16 ms period, and a pulse opens the valve from 2
 ended each pulse at its exact duty, the threshold would be the valve's own 26 %. This script runs the
 committed as-built preset both ways (FF + PVA and sliding mode, T1-T4, seeds 0-9) by swapping the two
 compiled valve kernels for sub-tick versions, and prints the mean RMSE per trajectory (deg). The result is
-recorded in docs/as-built.md.
+recorded in docs/investigations.md.
 
     python examples/trial_subtick_coil.py
 """
@@ -25,7 +25,7 @@ from twin.envs.runner import run_many
 from twin.plants.as_built import as_built_plant
 from twin.sim.scenario import Scenario
 
-# The preset this script's numbers in docs/as-built.md were measured on: the eighth refit's values, kept beside
+# The preset this script's numbers in docs/investigations.md were measured on: the eighth refit's values, kept beside
 # the scripts since the ninth refit (2026-11-26) replaced it as the committed preset.
 EIGHTH_REFIT = json.loads(pathlib.Path(__file__).with_name("eighth_refit.json").read_text())["fitted"]
 

@@ -12,7 +12,7 @@ START_DEG. Starts below 24 deg put the start outside the Coulomb fit, where the 
 resolution); the last start ends at 174 deg, the fit's other edge. It prints per start and law the RMSE (mean ±
 std over the runs), the largest error (mean), the RMS error over the move (0-1 s) and over the hold, and the
 SSE range of seeds 0-4 and of seeds 5-9. Nothing is refitted: the calibrated values were fitted with the start
-at 30 deg. The result is recorded in docs/as-built.md.
+at 30 deg. The result is recorded in docs/investigations.md.
 
     python examples/trial_t1_start.py
 """

@@ -4,7 +4,7 @@ The rig tracked T4 with sliding mode ahead of FF + PVA (1.82 against 1.95 deg); 
 puts FF + PVA ahead. This script runs both on T4 (0 g, horizontal) for each member of the committed
 calibration's ensemble (the ninth refit's, ``twin/plants/data/ninth_refit.json``), on seeds 0-4 (the verdict's) and on seeds 40-79 (which no step of the fit
 ran), and prints the members' profiled values and the four means. Its result (2026-11-26) is in
-docs/as-built.md.
+docs/investigations.md.
 
     python examples/trial_t4_order.py
 """

@@ -6,7 +6,7 @@ way. The only force the vertical set-up adds at 0 g is the 0.6 g link's weight, 
 its side, with the fitted leak past the discharge valves and without it, and prints the RMSE, the error
 during the 2 s hold (RMS over the hold, over its first and its last quarter second), when the move's last
 discharge pulse opens, how far the joint goes after it, and the error at the end (mean and std). The result
-is recorded in docs/as-built.md.
+is recorded in docs/investigations.md.
 
     python examples/trial_vertical_hold.py
 """
@@ -25,7 +25,7 @@ from twin.physics.model import Orientation
 from twin.plants.as_built import as_built_plant
 from twin.sim.scenario import Scenario
 
-# The preset this script's numbers in docs/as-built.md were measured on: the eighth refit's values, kept beside
+# The preset this script's numbers in docs/investigations.md were measured on: the eighth refit's values, kept beside
 # the scripts since the ninth refit (2026-11-26) replaced it as the committed preset.
 EIGHTH_REFIT = json.loads(pathlib.Path(__file__).with_name("eighth_refit.json").read_text())["fitted"]
 

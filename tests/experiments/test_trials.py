@@ -1,4 +1,4 @@
-"""The committed trial scripts whose printed numbers docs/as-built.md quotes: they still print them."""
+"""The committed trial scripts whose printed numbers the docs quote (mostly docs/investigations.md): they still print them."""
 
 from __future__ import annotations
 

@@ -133,9 +133,10 @@ def answer(rows: Sequence[dict], *, members: int, seeds: int) -> str:
                  f"these same runs, so an optimistic pick) changes RMSE by a median {signed(-faster)} deg, sliding "
                  f"mode at 16 ms by {signed(-sliding)} deg. A caveat that weighs on this answer: in the twin, "
                  f"FF + PVA at 16 ms already matches or beats sliding mode in {len(already)} of {len(cells)} cells, "
-                 "the reverse of the thesis's experiments (docs/as-built.md: at the thesis's phi the switching term "
-                 "is a few % of duty, and it is all that lifts the twin's sliding mode out of the valve's 26 % dead "
-                 "zone). So the twin can say what a faster PVA gains, but not yet that sliding mode gains less.")
+                 "the reverse of the thesis's experiments (docs/validation.md, \"Sliding mode's switching term\": at "
+                 "the thesis's phi the switching term is a few % of duty, and it is all that lifts the twin's sliding "
+                 "mode out of the valve's 26 % dead zone). So the twin can say what a faster PVA gains, but not yet "
+                 "that sliding mode gains less.")
     return "\n".join(lines)
 
 
