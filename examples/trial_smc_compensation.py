@@ -1,5 +1,5 @@
 """Trial (not installed): sliding mode with FF + PVA's dead-zone compensation, a reading of the law the
-thesis rules out.
+thesis does not give (its sliding mode has none).
 
 The rig's sliding mode tracked the slow trajectories at 0.75 (T2) and 0.81 (T3) of its FF + PVA; the
 twin's tracks them about as FF + PVA does, and misses both cells (x1.45, x1.33) and the controller order

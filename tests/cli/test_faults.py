@@ -1027,3 +1027,19 @@ def test_an_integer_too_long_for_a_float_is_a_one_line_error(argv, capsys):
         main(argv)
     assert stop.value.code == 2
     _one_line_error(capsys, "got '")
+
+
+def test_a_killed_pool_leaves_no_thread_running_into_the_exit():
+    """kill_pool kills the workers and waits for the pool's manager thread to end: left running into the
+    interpreter's exit it wrote to a closed pipe, and a Ctrl-C printed a traceback after its one line."""
+    from twin.batch import sweep
+
+    pool = sweep.fork_pool(2)
+    futures = [pool.submit(time.sleep, 30) for _ in range(4)]
+    while not any(f.running() for f in futures):
+        time.sleep(0.01)
+    manager = pool._executor_manager_thread
+    assert manager is not None and manager.is_alive()
+    sweep.kill_pool(pool)
+    assert not manager.is_alive()
+    assert all(not p.is_alive() for p in (pool._processes or {}).values())

@@ -132,20 +132,13 @@ def test_bench_shows_one_bar_with_its_total_and_labels_each_stage(monkeypatch, c
     assert stages == ["[1/4]", "[2/4]", "[3/4]", "[4/4]"]
 
 
-def test_a_resumed_sweeps_count_is_drawn_at_once():
-    """run_sweep counts what a resumed sweep had done in one call, at once; tqdm draws an update only after its
-    mininterval, so until the first batch ended a resumed study showed 0 of N (found 2026-11-27). counting()
-    redraws at each count; the sweep, the robustness study and the payload what-if use it."""
-    from twin.batch.sweep import counting
-
-    calls = []
-
-    class Bar:
-        def update(self, n):
-            calls.append(("update", n))
-
-        def refresh(self):
-            calls.append(("refresh",))
-
-    counting(Bar())(232)
-    assert calls == [("update", 232), ("refresh",)]
+def test_a_resumed_whatif_draws_what_was_done_before_its_first_batch(tmp_path, capsys):
+    """run_sweep counts what a resumed run had done in one call, at once, and tqdm draws an update only after its
+    mininterval: so until the first batch ended a resumed study showed 0 of N (found 2026-11-27). The sweep, the
+    robustness study and the payload what-if now count through sweep.counting, which redraws at each count."""
+    out = str(tmp_path / "p")
+    assert main(["whatif", "payload", "--payloads", "0", "--seeds", "1", "--workers", "1", "--out", out]) == 0
+    capsys.readouterr()
+    assert main(["whatif", "payload", "--payloads", "0,6.5", "--seeds", "1", "--workers", "1", "--out", out]) == 0
+    counts = _bar(capsys.readouterr().err, "payload")
+    assert counts[0] == (0, 8) and counts[1] == (4, 8) and counts[-1] == (8, 8), counts

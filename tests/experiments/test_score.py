@@ -117,7 +117,7 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     assert "6 of 12 T3 cells within 20 %" in text and "before any T3 measurement was seen" in text
     from twin.plants.as_built import preset_digest
 
-    assert (f"Prediction: the sixth blind prediction (the tenth refit's; the committed one), registered 2026-11-27 "
+    assert (f"Prediction: the sixth blind prediction (the tenth refit's), registered 2026-11-27 "
             f"(the package's `twin/experiments/data/`; `twin validate` on as-built preset {preset_digest()})." in text)
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["orders.csv", "score.csv", "score.md",
                                                                                     "score.png"]
@@ -131,18 +131,19 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     (lambda rows: [{**rows[0], "payload_g": "5"}, *rows[1:]], "line 2: no T3 cell FF + PVA 5 g horizontal"),
     (lambda rows: [{**rows[0], "rmse_std_deg": "-1"}, *rows[1:]], "line 2: rmse_std_deg must be a number from 0 to 180"),
     (lambda rows: [{**rows[0], "rmse_std_deg": "1e308"}, *rows[1:]], "line 2: rmse_std_deg must be a number from 0 to 180"),
-    (lambda rows: [{**rows[0], "rmse_mean_deg": "nan"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from 0.241 to 180"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "nan"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from 0.24 to 180"),
     (lambda rows: [{**rows[0], "rmse_mean_deg": "1e-320"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from"),
     (lambda rows: [{**rows[0], "rmse_mean_deg": "1_3"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from"),
     # Degrees: a mean below the Hall sensor's noise is most likely radians, one over half a turn no RMSE.
     (lambda rows: [{**r, "rmse_mean_deg": math.radians(float(r["rmse_mean_deg"]) * 2)} for r in rows],
      "radians would be about 57 times smaller"),
-    (lambda rows: [{**rows[0], "rmse_mean_deg": "1e308"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from 0.241 to 180"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "1e308"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from 0.24 to 180"),
     (lambda rows: [{**rows[0], "stalled_runs": "1"}, *rows[1:]],
      "gives stalled_runs on 1 of the 12 cells (not on FF + PVA 6.5 g horizontal): give it on every cell or on none"),
     (lambda rows: [{**rows[0], "runs": "1"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000, got '1'"),
     (lambda rows: [{**rows[0], "runs": "\u00b2"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000"),
     (lambda rows: [{**rows[0], "runs": "1" + "0" * 5000}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000"),
+    (lambda rows: [{**rows[0], "runs": "0" * 5000 + "5000"}, *rows[1:]], "line 2: runs must be a whole number from 2 to 1000"),
     (lambda rows: [{**rows[0], "stalled_runs": "6"}, *rows[1:]], "line 2: stalled_runs must be a whole number from 0 to 5"),
     (lambda rows: [{**rows[0], "trajectory": "1"}, *rows[1:]], "line 2: only the T3 cells are scored, got trajectory '1'"),
 ])
@@ -226,10 +227,10 @@ def test_a_validate_folder_can_be_scored_in_place_of_the_committed_prediction(tm
     # A broken folder is a one-line error, not a score.
     cells, members = (folder / "prediction.csv").read_text(), (folder / "prediction_members.csv").read_text()
     for name, content, message in (
-            ("prediction.csv", cells.replace(",2.0,1.9,", ",nan,1.9,", 1), "twin_mean must be a number from 0.241 to 180, got 'nan'"),
+            ("prediction.csv", cells.replace(",2.0,1.9,", ",nan,1.9,", 1), "twin_mean must be a number from 0.24 to 180, got 'nan'"),
             # A zero RMSE would divide by zero in a payload's cost.
-            ("prediction.csv", cells.replace(",2.0,1.9,", ",0,1.9,", 1), "twin_mean must be a number from 0.241 to 180, got '0'"),
-            ("prediction_members.csv", members.replace(",1.8", ",-1.8", 1), "twin_mean must be a number from 0.241"),
+            ("prediction.csv", cells.replace(",2.0,1.9,", ",0,1.9,", 1), "twin_mean must be a number from 0.24 to 180, got '0'"),
+            ("prediction_members.csv", members.replace(",1.8", ",-1.8", 1), "twin_mean must be a number from 0.24 to"),
             ("prediction_members.csv", members.replace(",1,", ",0,", 1), "member 0 of the cell is given twice"),
             ("prediction_members.csv", "".join(members.splitlines(keepends=True)[:-1]),
              "does not give every T3 cell the same members")):
@@ -261,9 +262,7 @@ def test_the_committed_prediction_is_the_current_table_of_docs_prediction_md():
 def test_only_a_prediction_on_record_is_scored_unless_told_and_then_every_output_says_so(tmp_path, capsys, monkeypatch):
     """The packaged files are the sixth prediction's, byte for byte; a file changed since (here one digit of the
     third decimal, which the 2-decimal tables of docs/prediction.md cannot see) is refused, or scored and marked."""
-    assert score.registration() == score.REGISTERED[0]
-    for folder in ("ninth_refit_prediction", "trial_air_box"):
-        assert score.registration(ROOT / "examples" / folder) in score.REGISTERED[1:]
+    assert score.registration() in score.REGISTERED
     changed = tmp_path / "data"
     changed.mkdir()
     for name in score.COMMITTED_FILES:
@@ -285,15 +284,44 @@ def test_only_a_prediction_on_record_is_scored_unless_told_and_then_every_output
     text = (out / "score.md").read_text(encoding="utf-8")
     assert "**NOT a prediction on record before the data**" in text
     assert "NOT a prediction on record before the data: 12 of 12 T3 cells within 20 %" in text
+    for name in ("score.csv", "orders.csv"):  # and the figure's title says "Unregistered"
+        with open(out / name, newline="") as handle:
+            assert {row["registered"] for row in csv.DictReader(handle)} == {"false"}, name
 
 
 def test_the_table_prints_what_its_verdicts_read():
-    """A measured mean equal to the band's end at 2 decimals but outside it unrounded reads 'no' beside a band
-    printed to 3 decimals, so the table does not contradict itself."""
+    """A band's end or a ratio that equals what it is compared with at 3 decimals is printed to as many more as
+    tell them apart, so that 'no' never stands beside numbers that read 'in' (found by a review, 2026-11-27)."""
     p = predicted(mean=lambda c, g, o: 2.3)
-    p[CELLS[0]]["p90"] = 2.379  # 2.38 at 2 decimals
-    s = score.score(measured_of(made_up(mean=lambda c, g, o: 2.38)), p)
-    row = s["cells"][0]
-    assert not row["in_band"] and f"{row['band_p90']:.2f}" == f"{row['measured']:.2f}"
+    p[CELLS[0]]["p90"] = 2.37771  # 2.378 at 3 decimals
+    p[CELLS[1]]["mean"] = 1.2004 * 2.0  # x1.200 at 3 decimals, out
+    s = score.score(measured_of(made_up(mean=lambda c, g, o: 2.378 if (c, g, o) == CELLS[0] else 2.0)), p)
+    first, second = s["cells"][:2]
+    assert not first["in_band"] and not second["within"]
     text = score.report(s, prediction="made up", measured="made up")
-    assert "| FF + PVA 0 g horizontal | 2.38 ± 0.1 | 2.300 | x0.966 | yes | 2.116-2.379 | no |" in text
+    assert "| FF + PVA 0 g horizontal | 2.378 ± 0.1 | 2.300 | x0.967 | yes | 2.116-2.3777 | no |" in text
+    assert "| FF + PVA 6.5 g horizontal | 2 ± 0.1 | 2.401 | x1.2004 | no |" in text
+
+
+def test_the_registered_predictions_are_append_only_and_each_is_its_files():
+    """The three predictions on record before any T3 data, pinned: an entry is never changed or removed (a refit's
+    prediction is appended); each entry's files and preset are the ones it names."""
+    from twin.plants.as_built import NINTH_REFIT_FILE, preset_digest
+
+    assert [(r.name, r.registered, r.preset) for r in score.REGISTERED[:3]] == [
+        ("the sixth blind prediction (the tenth refit's)", "2026-11-27", "1c2dcd8c9f7f"),
+        ("the fifth blind prediction (the ninth refit's; examples/ninth_refit_prediction)", "2026-11-26", "57ff10bf5b36"),
+        ("the air-box trial's prediction (examples/trial_air_box)", "2026-11-27", "3da50147f0ac")]
+    assert [(r.cells_sha256[:12], r.members_sha256[:12]) for r in score.REGISTERED[:3]] == [
+        ("aa932337bc6b", "32a6f6bce029"), ("4ca2fdca0a47", "28fd859f4e28"), ("9a133fe74794", "37fe7c0cde01")]
+    sixth, fifth, trial = score.REGISTERED[:3]
+    assert score.registration() == sixth and sixth.preset == preset_digest()  # the packaged files, the committed preset
+    assert score.registration(ROOT / "examples" / "ninth_refit_prediction") == fifth
+    assert fifth.preset == preset_digest(NINTH_REFIT_FILE)
+    assert score.registration(ROOT / "examples" / "trial_air_box") == trial
+    assert trial.preset == preset_digest(ROOT / "examples" / "trial_air_box" / "as_built.json")
+
+
+def test_a_whole_number_may_have_leading_zeros_of_any_length():
+    assert score._whole("0005", "t3.csv line 2", "runs", 2, 1000) == 5
+    assert score._whole("0" * 5000 + "7", "t3.csv line 2", "runs", 2, 1000) == 7

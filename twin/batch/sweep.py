@@ -180,6 +180,9 @@ def fork_pool(workers: int) -> concurrent.futures.ProcessPoolExecutor:
                                                   initializer=worker_setup)
 
 
+MANAGER_JOIN_S = 5.0  # s: how long a killed pool's manager thread may take to see its workers gone (it takes ms)
+
+
 def kill_pool(pool: concurrent.futures.ProcessPoolExecutor) -> None:
     """Stop ``pool`` now: its queued calls cancelled, its workers killed rather than waited for. Then wait (a
     few seconds at most) for the pool's manager thread to see them gone and end: left running into the
@@ -191,7 +194,7 @@ def kill_pool(pool: concurrent.futures.ProcessPoolExecutor) -> None:
     for process in processes:
         process.kill()
     if manager is not None:
-        manager.join(timeout=5.0)
+        manager.join(timeout=MANAGER_JOIN_S)
 
 
 def worker_setup() -> None:

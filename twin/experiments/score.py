@@ -74,7 +74,7 @@ MAX_BYTES = 1_000_000  # a file of twelve cells is under 1 kB; past this it is t
 MAX_RUNS = 1000  # runs per measured cell: more is a typing error, not a rig's day (left out: the thesis's five)
 # A measured RMSE below the Hall sensor's noise bound (0.02 mm of rack, 0.24 deg; SPEC §5) is no measurement of
 # this rig (most likely radians); above half a turn, none either (the joint's range is 180 deg).
-SMALLEST_MEAN_DEG = math.degrees(SensorParams().position_noise / GearParams().spur_radius)
+SMALLEST_MEAN_DEG = round(math.degrees(SensorParams().position_noise / GearParams().spur_radius), 2)  # 0.24 deg
 LARGEST_DEG = 180.0
 
 
@@ -90,10 +90,11 @@ class Registration:
     members_sha256: str
 
 
-# Every prediction `twin score` scores without --unregistered. A refit's new prediction is added here, dated, only
-# while no T3 measurement has been seen; the test holds the packaged files to the first entry.
+# Every prediction `twin score` scores without --unregistered. Append-only: a refit's new prediction is added at the
+# end, dated, only while no T3 measurement has been seen, and no entry is ever changed or removed (a test pins them).
+# The packaged files must be one of them (a test holds them to it).
 REGISTERED = (
-    Registration("the sixth blind prediction (the tenth refit's; the committed one)", "2026-11-27", "1c2dcd8c9f7f",
+    Registration("the sixth blind prediction (the tenth refit's)", "2026-11-27", "1c2dcd8c9f7f",
                  "aa932337bc6b2b5cbe920d14f1e46eb0f1955785740ec3371327bcd43b3d9765",
                  "32a6f6bce0291874960e0c1930f1bb583640573622aa0ae3cc85bb0c5e3ede8b"),
     Registration("the fifth blind prediction (the ninth refit's; examples/ninth_refit_prediction)", "2026-11-26",
@@ -108,8 +109,9 @@ ORDER_LABELS = {**CONTROLLER_LABELS, TIE: "neither (equal means)"}
 TOSS_SE = 2.0  # measured means closer than this many combined standard errors: the order is a toss
 SCORE_COLUMNS = ("controller", "payload_g", "orientation", "measured", "measured_std", "runs", "twin_mean",
                  "band_p10", "band_p90", "member_low", "member_high", "ratio", "within", "in_band", "in_members", "z",
-                 "measured_stalled_runs", "twin_stalled_runs", "twin_runs")
-ORDER_COLUMNS = ("payload_g", "orientation", "measured_better", "measured_toss", "predicted_better", "right")
+                 "measured_stalled_runs", "twin_stalled_runs", "twin_runs", "registered")
+ORDER_COLUMNS = ("payload_g", "orientation", "measured_better", "measured_toss", "predicted_better", "right",
+                 "registered")  # registered: whether the prediction scored is on record (false: --unregistered)
 CONTROLLER_NAMES = {**{name: name for name in CONTROLLER_LABELS}, **{label.lower(): name for name, label in
                                                                       CONTROLLER_LABELS.items()}}
 CELL_KEYS = tuple((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # (controller, payload g, orientation)
@@ -160,10 +162,11 @@ def _number(text: str, where: str, column: str, *, low: float = 0.0, high: float
 
 
 def _whole(text: str, where: str, column: str, low: int, high: int) -> int:
-    """``text`` as a whole number from ``low`` to ``high``, else a one-line error."""
-    if not (text.isascii() and text.isdigit()) or len(text.lstrip("0")) > len(str(high)) or not low <= int(text) <= high:
+    """``text`` as a whole number from ``low`` to ``high``, else a one-line error (leading zeros allowed)."""
+    digits = text.lstrip("0") or "0"  # int() refuses over 4300 digits: the length is checked first
+    if not (text.isascii() and text.isdigit()) or len(digits) > len(str(high)) or not low <= int(digits) <= high:
         raise InvalidScenario(f"{where}: {column} must be a whole number from {low} to {high}, got {text!r}")
-    return int(text)
+    return int(digits)
 
 
 def _cell_key(row: dict, where: str) -> tuple[str, float, str]:
@@ -213,7 +216,7 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
         raise InvalidScenario(f"measured file {str(path)!r} has the column(s) {', '.join(unknown)}, which are not "
                               f"read (it takes {', '.join(MEASURED_COLUMNS)}; optional: {', '.join(OPTIONAL_COLUMNS)})")
     found: dict[tuple, dict] = {}
-    degrees = (f" (degrees, from the Hall sensor's noise, {SMALLEST_MEAN_DEG:.2f}, to half a turn; radians "
+    degrees = (f" (degrees, from the Hall sensor's noise, {SMALLEST_MEAN_DEG:g}, to half a turn; radians "
                f"would be about 57 times smaller)")
     for where, key, row in _each_cell(rows, path, found):
         runs = _whole(row.get("runs") or str(THESIS_RUNS), where, "runs", 2, MAX_RUNS)
@@ -359,6 +362,16 @@ def _fitted_note() -> str:
             "which `twin calibrate` fitted. The other ten were predicted before any was seen.")
 
 
+def _apart(value: float, other: float, decimals: int = 3) -> str:
+    """``value`` to ``decimals`` places, or to as many more (up to 9) as tell it from ``other``, so that a verdict
+    comparing the two can be read off the printed numbers."""
+    for places in range(decimals, 10):
+        text = f"{value:.{places}f}"
+        if value == other or text != f"{other:.{places}f}":
+            return text
+    return repr(value)
+
+
 def _stalls(row: dict) -> str:
     measured = ("not given" if row["measured_stalled_runs"] is None else
                 f"{row['measured_stalled_runs']} of {row['runs']}")
@@ -389,16 +402,19 @@ def report(s: dict, *, prediction: str, measured: str) -> str:
         "ensemble's 10-90 % band; `in members`: inside the members' range (lowest to highest member mean). `z`: "
         "the committed mean less the measured mean, in the measured mean's standard errors (std / sqrt(runs)); "
         "positive: the twin predicted a larger error. Every verdict is on the unrounded numbers; the twin's are "
-        "printed to 3 decimals so that each verdict can be read off the table.", "",
+        "printed to 3 decimals, or to as many more as tell a band's end or the ratio from what it is compared with, "
+        "so that each verdict can be read off the table.", "",
         "| cell | measured | committed | ratio | within | band p10-p90 | in band | members | in members | z | "
         "stalled runs: measured, twin |",
         "|---|---|---|---|---|---|---|---|---|---|---|"]
     yes = {True: "yes", False: "no"}
     for r in s["cells"]:
-        lines.append(f"| {_cell_name(r)} | {r['measured']:g} ± {r['measured_std']:g} | {r['twin_mean']:.3f} | "
-                     f"x{r['ratio']:.3f} | {yes[r['within']]} | {r['band_p10']:.3f}-{r['band_p90']:.3f} | "
-                     f"{yes[r['in_band']]} | {r['member_low']:.3f}-{r['member_high']:.3f} | {yes[r['in_members']]} | "
-                     f"{r['z']:+.1f} | {_stalls(r)} |")
+        m = r["measured"]
+        edge = 1 + math.copysign(RMSE_TOLERANCE, r["ratio"] - 1)  # the tolerance's nearer end
+        lines.append(f"| {_cell_name(r)} | {m:g} ± {r['measured_std']:g} | {r['twin_mean']:.3f} | "
+                     f"x{_apart(r['ratio'], edge)} | {yes[r['within']]} | {_apart(r['band_p10'], m)}-"
+                     f"{_apart(r['band_p90'], m)} | {yes[r['in_band']]} | {_apart(r['member_low'], m)}-"
+                     f"{_apart(r['member_high'], m)} | {yes[r['in_members']]} | {r['z']:+.1f} | {_stalls(r)} |")
     lines += ["", "## Which controller tracked better", "",
               f"A toss: the measured means differ by less than {TOSS_SE:g} combined standard errors.", "",
               "| payload | orientation | measured | predicted | right |", "|---|---|---|---|---|"]
@@ -438,7 +454,7 @@ def figure(s: dict, path: pathlib.Path) -> None:
               label="members' range")
     ax.vlines(x, [r["band_p10"] for r in cells], [r["band_p90"] for r in cells], color="tab:blue", lw=6, alpha=0.4,
               label="10-90 % band")
-    ax.plot(x, [r["twin_mean"] for r in cells], "o", color="tab:blue", label="committed preset")
+    ax.plot(x, [r["twin_mean"] for r in cells], "o", color="tab:blue", label="predicted (its preset)")
     ax.errorbar(x + 0.18, [r["measured"] for r in cells],
                 yerr=[2 * r["measured_std"] / math.sqrt(r["runs"]) for r in cells], fmt="s", color="black",
                 capsize=3, label="measured ± 2 SE")
@@ -493,6 +509,8 @@ class ScoreExperiment(Experiment):
         s = score(read_measured(args.measured), read_prediction(args.prediction))
         record = registration(args.prediction)
         s["registered"] = record is not None
+        for row in (*s["cells"], *s["orders"]):
+            row["registered"] = s["registered"]
         s["short_name"] = "Unregistered T3 prediction" if record is None else record.name.split(" (")[0].capitalize()
         s["report"] = report(s, measured=f"`{args.measured}`", prediction=prediction_name(record, args.prediction))
         return Outcome(rows=s["cells"], answer=answer(s), detail=s)

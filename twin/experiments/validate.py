@@ -523,6 +523,10 @@ def opening_command(ticks_to_open: int, period_ticks: int) -> float:
     return (ticks_to_open - 0.5) / period_ticks * 100.0
 
 
+class NoClosedForm(ValueError):
+    """:func:`opening_lag` has no closed form for this law: its switching term saturates before the valve opens."""
+
+
 def opening_lag(controller, nominal, position, speed: float, *, ticks_to_open: int, period_ticks: int,
                 tick: float):
     """Closed form: the error (m, >= 0) at a period's start at which ``controller`` (built by
@@ -572,7 +576,7 @@ def opening_lag(controller, nominal, position, speed: float, *, ticks_to_open: i
         lag = (np.maximum(opening - u_ff - g.pva.velocity * speed - per_speed * (speed + g.surface_slope * grown), 0.0)
                / (g.pva.position + per_speed * g.surface_slope))
         if np.any(speed + g.surface_slope * (lag + grown) >= g.boundary_layer):
-            raise ValueError("the switching term saturates before the valve opens: no closed form here")
+            raise NoClosedForm("the switching term saturates before the valve opens: no closed form here")
     else:
         raise TypeError(f"no closed form for {type(controller).__name__}")
     return lag if lag.ndim else float(lag)
@@ -597,7 +601,7 @@ def ramp_opening_lags(plant, nominal, laws: dict) -> dict:
         try:
             return math.degrees(float(np.median(opening_lag(law, nominal, positions, RAMP_SPEED, ticks_to_open=n_open,
                                                             period_ticks=period_ticks, tick=plant.timestep))) / radius)
-        except ValueError:  # saturated: no closed form
+        except NoClosedForm:
             return math.nan
 
     lags = {name: lag(law) for name, law in laws.items()}
