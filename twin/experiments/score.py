@@ -23,8 +23,9 @@ The rules (:func:`score`). Changing one after a measurement has been seen is a n
   the ensemble's 10-90 % band; ``in_members`` when it lies in the members' range (lowest to highest member
   mean); ``z``, the committed mean's distance from the measured mean in the measured mean's standard errors
   (std / sqrt(runs)). Each is judged on the numbers as given and computed, unrounded (``score.md`` prints
-  them to 3 decimals so that a verdict can be read off its table; added 2026-11-27, before any T3
-  measurement was seen, after a review found a 2-decimal table that read "in" beside a "no").
+  them to 3 decimals, or more where a band's end or the ratio would read equal to what it is compared with,
+  so that a verdict can be read off its table; added 2026-11-27, before any T3 measurement was seen, after a
+  review found a 2-decimal table that read "in" beside a "no").
 * Per payload and orientation: which controller tracked better, measured and predicted (the committed
   means), or neither when the two means are equal; the measured order is **a toss** when the two measured
   means differ by less than two combined standard errors (or are equal). Right: the same answer.
@@ -382,8 +383,9 @@ def answer(s: dict) -> str:
     """One line: how the prediction fared (first saying so when it is not on record)."""
     cells, orders = s["cells"], s["orders"]
     c3 = s["conclusions"][3]
-    return (("NOT a prediction on record before the data: " if not s.get("registered", True) else "") + f"{sum(r['within'] for r in cells)} of {len(cells)} T3 cells within {RMSE_TOLERANCE * 100:.0f} % of the measured "
-            f"mean; {sum(r['in_band'] for r in cells)} inside the 10-90 % band, {sum(r['in_members'] for r in cells)} "
+    unregistered = "" if s.get("registered", True) else "NOT a prediction on record before the data: "
+    return (f"{unregistered}{sum(r['within'] for r in cells)} of {len(cells)} T3 cells within "
+            f"{RMSE_TOLERANCE * 100:.0f} % of the measured mean; {sum(r['in_band'] for r in cells)} inside the 10-90 % band, {sum(r['in_members'] for r in cells)} "
             f"inside the members' range; controller order right in {sum(o['right'] for o in orders)} of "
             f"{len(orders)} pairs ({sum(o['measured_toss'] for o in orders)} a toss on the measured runs); sliding "
             f"mode better in {c3['measured']} of {c3['of']} measured, {c3['predicted']} predicted.")
