@@ -1269,6 +1269,14 @@ def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[d
             + (", within" if flat["within_tolerance"] else ", out")
             + (_phase_cost(here, base) if here and base else "")
             + "; why the payload costs the twin's law differently, the twin does not show")
+    if cost and flat and f and _loaded(r):  # what the two payload checks do show, though neither reads the miss
+        return "open", (
+            f"none of the other checks explains it alone: on seeds {flat['seeds']}, where this cell is "
+            f"x{f['ratio']:.2f}, the payload's cost "
+            + ("matches" if abs(cost["difference_in_se"]) <= EFFECT_SIGNIFICANCE else "differs from")
+            + f" the rig's (x{cost['twin_effect']:.2f} against x{cost['measured_effect']:.2f}, "
+            f"{cost['difference_in_se']:+.1f} combined standard errors) and its controller's 0 g flat cell is "
+            f"x{flat['ratio']:.2f}, " + ("within" if flat["within_tolerance"] else "out"))
     return "open", "none of the other checks explains it"
 
 
