@@ -45,11 +45,12 @@ from twin.envs.live import Compare, LiveJoint, LiveJoints, Readout
 from twin.exceptions import SimulationFailed, TwinError
 from twin.sim.scenario import Scenario
 from viz import live_messages
-from viz.recording import FPS, MESHCAT_SCRIPT, STRIP_CHART_SCRIPT, TraceRows, compare_label, title_of, write_page
+from viz.recording import FPS, MESHCAT_SCRIPT, STRIP_CHART_SCRIPT, TraceRows, compare_label, write_page
 from viz.scene import COMPARE_ROOT, COMPARE_TINT, Frame, JointScene, frame_commands, scene_commands
 
 FRAME_RATE = 30.0  # pictures per second of wall time (and plot updates)
 SAMPLE_PERIOD = 5e-3  # s of simulated time between plotted samples (valves: every change)
+MAX_TITLED_RUNS = 4  # a live recording's title names at most the last four things the joint ran
 REPLAY_ON_CONNECT = 1  # the trajectory replayed when the first page connects, so the joint moves on open
 STOP_GRACE = 0.3  # s for the last messages to leave before the server's loop ends
 MIN_REBUILD_INTERVAL = 0.5  # s between model rebuilds (each compiles the model on the server's thread)
@@ -160,6 +161,8 @@ class LiveSession:
                                                     strict=False)]
         self.samples = [_Samples() for _ in self.joints.joints]
         self.recorder = _Recorder()
+        self.runs: list[str] = []  # what the first joint ran since this model was built, in order: the recording's title
+        self._note_run()
         self._debt = 0.0  # s of simulated time asked for but not yet a whole tick
         self.record_every = max(1, round(1.0 / (FPS * self.joint.tick)))
         self.sample_every = max(1, round(SAMPLE_PERIOD / self.joint.tick))
@@ -180,8 +183,10 @@ class LiveSession:
         return self.joint.scenario
 
     def setup_commands(self) -> list[dict]:
+        """The scene, and every body posed as now: the page fits its camera on the state that follows, which
+        must see the bodies where they are (a joint on its side is turned by its pose, not by its scene)."""
         return [Delete(Path(("twin",))).lower(), Delete(Path((COMPARE_ROOT,))).lower(),
-                *scene_commands(self.scenes)]
+                *scene_commands(self.scenes), *frame_commands(self.frame())]
 
     def frame(self) -> Frame:
         """Every joint's picture as one frame."""
@@ -234,29 +239,38 @@ class LiveSession:
                 raise SimulationFailed(f"MuJoCo {', '.join(warned) or 'state not finite'} at "
                                        f"t = {joint.time:.3f} s{which}")
 
+    def _note_run(self) -> None:
+        """Add what the first joint runs now (its controller and plan) to :attr:`runs`, unless it is the last."""
+        state = self.state()
+        run = f"{state['controller']} {state['playing']}"
+        if not self.runs or self.runs[-1] != run:
+            self.runs.append(run)
+
     def handle(self, text: str | bytes) -> bool:
         """Apply one message from the page; True if the model was rebuilt. Raises BadMessage."""
         command = live_messages.parse(text)
-        if isinstance(command, live_messages.Target):
-            self.joints.set_target(command.angle)
-        elif isinstance(command, live_messages.PlayTrajectory):
-            self.joints.play(command.number)
-        elif isinstance(command, live_messages.SwitchController):
-            self.joints.switch_controller(command.name)
-        else:
-            now = time.monotonic()
-            if now - self._rebuilt_at < MIN_REBUILD_INTERVAL:
-                raise live_messages.BadMessage(f"the model was rebuilt {now - self._rebuilt_at:.1f} s ago: "
-                                               f"wait {MIN_REBUILD_INTERVAL:g} s between payload/orientation changes")
-            changes = {k: v for k, v in dataclasses.asdict(command).items() if v is not None}
-            self._start(dataclasses.replace(self.scenario, **changes))
-            self._rebuilt_at = now
-            return True
-        return False
+        if isinstance(command, live_messages.Target | live_messages.PlayTrajectory | live_messages.SwitchController):
+            if isinstance(command, live_messages.Target):
+                self.joints.set_target(command.angle)
+            elif isinstance(command, live_messages.PlayTrajectory):
+                self.joints.play(command.number)
+            else:
+                self.joints.switch_controller(command.name)
+            self._note_run()
+            return False
+        now = time.monotonic()
+        if now - self._rebuilt_at < MIN_REBUILD_INTERVAL:
+            raise live_messages.BadMessage(f"the model was rebuilt {now - self._rebuilt_at:.1f} s ago: "
+                                           f"wait {MIN_REBUILD_INTERVAL:g} s between payload/orientation changes")
+        changes = {k: v for k, v in dataclasses.asdict(command).items() if v is not None}
+        self._start(dataclasses.replace(self.scenario, **changes))
+        self._rebuilt_at = now
+        return True
 
     def play(self, number: int) -> None:
         """Replay trajectory ``number`` on every joint (as the page's T buttons do)."""
         self.joints.play(number)
+        self._note_run()
 
     def readout(self) -> dict:
         """The first joint's readout now (and the second's angle), with every joint's samples since
@@ -291,10 +305,13 @@ class LiveSession:
         rows = [self.recorder.trace_rows()]
         if self.joints.second is not None:
             rows.append(self.recorder.trace_rows(compare=True))
-        title = f"live: {title_of(self.scenario)}"
+        s = self.scenario
+        runs = ("" if len(self.runs) <= MAX_TITLED_RUNS else "... ") + ", then ".join(self.runs[-MAX_TITLED_RUNS:])
+        title = f"live: {runs}; {s.payload * 1e3:g} g {s.orientation.value} ({s.plant_name}, seed {s.seed})"
         if self.compare is not None:
             title += f" vs {compare_label(self.compare.text)}"
-        labels = [f"{self.scenario.controller}, {self.scenario.plant_name}"]
+        controllers = ", ".join(dict.fromkeys(run.split()[0] for run in self.runs))
+        labels = [f"{controllers}, {s.plant_name}"]
         if self.compare is not None:
             labels.append(f"compare: {compare_label(self.compare.text)}")
         write_page(tmp, scenes=self.scenes, frames=self.recorder.frames, rows=rows, title=title, labels=labels)

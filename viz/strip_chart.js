@@ -24,6 +24,12 @@ const TWIN_CHARTS = [
   {id: "valves", title: "valves (open)", unit: "", kind: "valves"},
 ];
 const TWIN_COMPARE_TINT = "#12a5b0";
+
+// A number with ``digits`` decimals, never "-0" (a small negative duty or pressure reads 0): both pages' readouts.
+function twinFixed(x, digits) {
+  const text = x.toFixed(digits);
+  return Number(text) === 0 ? (0).toFixed(digits) : text;
+}
 const TWIN_CAMERA_FOV = 35;  // deg, vertical field of view of the 3D view  // teal, as the second joint in the 3D view (viz/scene.py COMPARE_TINT)
 
 class StripCharts {
@@ -94,12 +100,21 @@ class StripCharts {
     return [spec.fromZero ? lo : lo - pad, hi + pad];
   }
 
+  // Round ticks over [lo, hi], about ``count`` of them, and never fewer than two (a short chart with one
+  // labelled tick cannot be read: the step is halved or so until two fit).
   _ticks(lo, hi, count) {
     const raw = (hi - lo) / count;
     const power = Math.pow(10, Math.floor(Math.log10(raw)));
-    const step = [1, 2, 5, 10].map((m) => m * power).find((s) => s >= raw) || raw;
-    const ticks = [];
-    for (let v = Math.ceil(lo / step) * step; v <= hi + 1e-9; v += step) ticks.push(Math.abs(v) < 1e-9 ? 0 : v);
+    const steps = [0.1, 0.2, 0.5, 1, 2, 5, 10].map((m) => m * power);
+    const at = (step) => {
+      const ticks = [];
+      for (let k = Math.ceil(lo / step - 1e-9); k * step <= hi + 1e-9; k++) ticks.push(Math.abs(k * step) < 1e-9 ? 0 : k * step);
+      return ticks;
+    };
+    let i = steps.findIndex((s) => s >= raw);
+    if (i < 0) i = steps.length - 1;
+    let ticks = at(steps[i]);
+    while (ticks.length < 2 && i > 0) ticks = at(steps[--i]);
     return ticks;
   }
 
@@ -179,6 +194,8 @@ class StripCharts {
     }
   }
 
+  // The legend, right-aligned between ``leftmost`` (the title's end) and ``right``: in a smaller font when
+  // it does not fit, and only then without its last items (the first series, as chamber A, stays).
   _legend(ctx, spec, count, right, y, leftmost = 0) {
     ctx.textAlign = "right";
     ctx.textBaseline = "alphabetic";
@@ -186,8 +203,11 @@ class StripCharts {
     const items = [];
     for (const s of spec.series) items.push([s.label, s.color, s.dash || []]);
     if (count > 1) items.push([this.labels[1] || "compare", TWIN_COMPARE_TINT, [5, 3]]);
+    const needs = () => items.reduce((w, [label]) => w + ctx.measureText(label).width + 23, 0);
+    for (let size = 9; size >= 8 && needs() > right - leftmost; size--) ctx.font = `${size}px sans-serif`;
+    while (items.length > 1 && needs() > right - leftmost) items.pop();
     for (const [label, color, dash] of items.reverse()) {
-      if (x - ctx.measureText(label).width - 20 < leftmost) break;  // no room: the title stays readable
+      if (x - ctx.measureText(label).width - 20 < leftmost) break;  // no room even for one: the title stays readable
       ctx.fillStyle = "#333";
       ctx.fillText(label, x, y);
       x -= ctx.measureText(label).width + 3;
@@ -198,12 +218,14 @@ class StripCharts {
       ctx.setLineDash([]);
       x -= 20;
     }
+    ctx.font = "10px sans-serif";
   }
 
   _drawValves(ctx, traces, t0, t1, xOf, left, top, width, height) {
     const rows = 4, rowHeight = height / rows;
     ctx.textAlign = "right";
     ctx.textBaseline = "middle";
+    ctx.font = `${Math.max(7, Math.min(10, Math.floor(rowHeight)))}px sans-serif`;  // V1-V4 apart on a short chart
     for (let v = 0; v < rows; v++) {
       ctx.fillStyle = "#444";
       ctx.fillText("V" + (v + 1), left - 3, top + (v + 0.5) * rowHeight);
@@ -229,6 +251,7 @@ class StripCharts {
         }
       }
     });
+    ctx.font = "10px sans-serif";
     const legend = {spec: {series: [{label: "open", color: "#2ca02c"}]}};
     this._legend(ctx, legend.spec, share, left + width, 11, left + 80);
   }

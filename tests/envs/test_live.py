@@ -286,6 +286,40 @@ def test_live_recording_keeps_every_fiftieth_of_a_second(tmp_path):
     assert len(quaternions["keys"]) == 76 and spur["clip"]["fps"] == 50
 
 
+def test_a_live_recordings_title_names_what_the_joint_ran(tmp_path):
+    """The title said the current controller and the command line's trajectory, whatever was run before
+    (found 2026-11-27): it now names each controller and plan the recording holds, in order."""
+    session = LiveSession(Scenario("ffpva", 1, seed=0), record=True)
+    session.play(1)
+    session.advance(0.2)
+    session.handle('{"type": "controller", "name": "pva"}')
+    session.handle('{"type": "trajectory", "number": 2}')
+    session.handle('{"type": "trajectory", "number": 2}')  # the same again: named once
+    session.advance(0.2)
+    assert session.runs == ["ffpva T1", "pva T1", "pva T2"]
+    path = tmp_path / "live.html"
+    session.write_html(path)
+    assert "live: ffpva T1, then pva T1, then pva T2; 0 g horizontal (thesis, seed 0)" in path.read_text()
+    for number in (3, 4, 1, 2):
+        session.play(number)
+    session.write_html(path)
+    assert "live: ... pva T3, then pva T4, then pva T1, then pva T2; 0 g" in path.read_text()
+
+
+def test_the_live_setup_poses_every_body_before_the_state_that_fits_the_camera():
+    """The page fits its camera on the state that follows the setup: the setup must pose the bodies (a joint on
+    its side is turned by its pose; fitted unposed, the camera cut off the mechanism, found 2026-11-27)."""
+    from twin.physics.model import Orientation
+    from viz.scene import frame_commands
+
+    session = LiveSession(Scenario("ffpva", 1, orientation=Orientation.VERTICAL, seed=0))
+    setup = session.setup_commands()
+    poses = frame_commands(session.frame())
+    assert setup[-len(poses):] == poses
+    housing = next(c for c in poses if c["type"] == "set_transform" and c["path"].endswith("/housing"))
+    assert not np.allclose(np.asarray(housing["matrix"], dtype=float).reshape(4, 4), np.eye(4))
+
+
 @pytest.mark.parametrize("rack, contact", [("a", math.pi / 2), ("b", -math.pi / 2)])
 def test_rack_teeth_fill_the_pinion_gap_and_cover_the_travel(rack, contact):
     from viz.scene import rack_teeth_layout
