@@ -499,17 +499,20 @@ class ScoreExperiment(Experiment):
                                  "every output then says so")
 
     def check(self, args: argparse.Namespace) -> None:
-        read_measured(args.measured)
-        read_prediction(args.prediction)
-        if registration(args.prediction) is None and not args.unregistered:
+        """Reads both inputs and the prediction's registration once; :meth:`run` uses them (as other experiments
+        keep what their check parsed on ``args``)."""
+        args.measured_cells = read_measured(args.measured)
+        args.predicted_cells = read_prediction(args.prediction)
+        args.record = registration(args.prediction)
+        if args.record is None and not args.unregistered:
             which = ("the packaged prediction (twin/experiments/data/)" if args.prediction is None
                      else f"--prediction {str(args.prediction)!r}")
             raise InvalidScenario(f"{which} is not a prediction on record before the T3 data: its files match none "
                                   "in twin/experiments/score.py's REGISTERED (--unregistered scores it, marked so)")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:
-        s = score(read_measured(args.measured), read_prediction(args.prediction))
-        record = registration(args.prediction)
+        s = score(args.measured_cells, args.predicted_cells)
+        record = args.record
         s["registered"] = record is not None
         for row in (*s["cells"], *s["orders"]):
             row["registered"] = s["registered"]
