@@ -753,3 +753,148 @@ def test_prediction_md_quotes_the_registered_predictions_kept_in_examples(headin
         wanted = [f"{float(r[k]):.2f}" for k in ("twin_mean", "band_p10", "band_p50", "band_p90")]
         wanted += [f"{min(members[key]):.2f}-{max(members[key]):.2f}", r["stalled_runs"]]
         assert quoted[key] == wanted, key
+
+
+@pytest.mark.slow  # about 45 s on 2 cores: the 21 measured cells, five seeds, six ways; three seconds shut
+def test_trial_initial_pressure_prints_what_investigations_md_quotes(capsys):
+    _load("trial_initial_pressure").main()
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == ("as-built preset 1c2dcd8c9f7f (committed), seeds 0-4; chambers starting at 0.5 of the supply "
+                      "give the committed runs bit for bit: True")
+    assert out[1] == "shut from half the supply, chambers A / B (kPa): 0 s 150 / 150, 1 s 98 / 106, 2 s 72 / 83, 3 s 57 / 67"
+    rows = {line.split(": ", 1)[0]: line.split(": ", 1)[1].split(" | ") for line in out[2:7]}
+    # start -> cells within 20 % and SSE ranges within ±0.5 deg, then each cell's mean RMSE (and T1's SSE range)
+    assert rows == {
+        "start at 0 of the supply": [
+            "within 20 % 16 of 21, SSE ranges within 12 of 13",
+            "PVA T1 1.95 (±0.52)",
+            "PVA T2 2.91",
+            "PVA T3 3.05",
+            "FF+PVA T1 1.63 (±0.49)",
+            "FF+PVA T2 2.47",
+            "FF+PVA T3 2.38",
+            "FF+PVA T4 2.05",
+            "SMC T1 1.32 (±0.48)",
+            "SMC T2 2.31",
+            "SMC T3 2.21",
+            "SMC T4 1.77",
+            "FF+PVA T1 6.5gH 1.92 (±1.58)",
+            "FF+PVA T1 13.5gH 1.95 (±1.68)",
+            "FF+PVA T1 0gV 1.71 (±0.88)",
+            "FF+PVA T1 6.5gV 1.87 (±1.22)",
+            "FF+PVA T1 13.5gV 3.85 (±2.24)",
+            "SMC T1 6.5gH 1.50 (±0.40)",
+            "SMC T1 13.5gH 1.57 (±0.47)",
+            "SMC T1 0gV 1.47 (±1.02)",
+            "SMC T1 6.5gV 1.88 (±0.66)",
+            "SMC T1 13.5gV 3.52 (±1.32)",
+        ],
+        "start at 0.25 of the supply": [
+            "within 20 % 16 of 21, SSE ranges within 9 of 13",
+            "PVA T1 1.97 (±0.39)",
+            "PVA T2 2.96",
+            "PVA T3 3.03",
+            "FF+PVA T1 1.49 (±0.50)",
+            "FF+PVA T2 2.39",
+            "FF+PVA T3 2.38",
+            "FF+PVA T4 1.97",
+            "SMC T1 1.48 (±0.46)",
+            "SMC T2 2.33",
+            "SMC T3 2.18",
+            "SMC T4 1.81",
+            "FF+PVA T1 6.5gH 1.71 (±0.52)",
+            "FF+PVA T1 13.5gH 2.06 (±1.47)",
+            "FF+PVA T1 0gV 1.58 (±0.72)",
+            "FF+PVA T1 6.5gV 1.93 (±2.04)",
+            "FF+PVA T1 13.5gV 3.76 (±1.36)",
+            "SMC T1 6.5gH 1.48 (±0.54)",
+            "SMC T1 13.5gH 1.50 (±0.47)",
+            "SMC T1 0gV 1.55 (±1.02)",
+            "SMC T1 6.5gV 1.75 (±1.20)",
+            "SMC T1 13.5gV 3.40 (±1.08)",
+        ],
+        "start at 0.5 of the supply": [
+            "within 20 % 17 of 21, SSE ranges within 9 of 13",
+            "PVA T1 1.86 (±0.52)",
+            "PVA T2 2.91",
+            "PVA T3 3.04",
+            "FF+PVA T1 1.53 (±0.55)",
+            "FF+PVA T2 2.37",
+            "FF+PVA T3 2.38",
+            "FF+PVA T4 2.00",
+            "SMC T1 1.42 (±0.50)",
+            "SMC T2 2.30",
+            "SMC T3 2.21",
+            "SMC T4 1.78",
+            "FF+PVA T1 6.5gH 1.52 (±0.47)",
+            "FF+PVA T1 13.5gH 1.92 (±1.49)",
+            "FF+PVA T1 0gV 1.48 (±1.65)",
+            "FF+PVA T1 6.5gV 1.83 (±1.32)",
+            "FF+PVA T1 13.5gV 4.05 (±1.12)",
+            "SMC T1 6.5gH 1.33 (±0.54)",
+            "SMC T1 13.5gH 1.47 (±0.48)",
+            "SMC T1 0gV 1.52 (±0.88)",
+            "SMC T1 6.5gV 1.66 (±1.11)",
+            "SMC T1 13.5gV 3.32 (±0.84)",
+        ],
+        "start at 0.75 of the supply": [
+            "within 20 % 18 of 21, SSE ranges within 8 of 13",
+            "PVA T1 1.86 (±0.49)",
+            "PVA T2 3.06",
+            "PVA T3 2.98",
+            "FF+PVA T1 1.49 (±0.42)",
+            "FF+PVA T2 2.45",
+            "FF+PVA T3 2.36",
+            "FF+PVA T4 1.92",
+            "SMC T1 1.32 (±0.50)",
+            "SMC T2 2.31",
+            "SMC T3 2.25",
+            "SMC T4 1.78",
+            "FF+PVA T1 6.5gH 1.51 (±0.48)",
+            "FF+PVA T1 13.5gH 1.87 (±0.41)",
+            "FF+PVA T1 0gV 1.63 (±1.65)",
+            "FF+PVA T1 6.5gV 1.82 (±1.39)",
+            "FF+PVA T1 13.5gV 3.97 (±1.24)",
+            "SMC T1 6.5gH 1.38 (±0.54)",
+            "SMC T1 13.5gH 1.46 (±0.47)",
+            "SMC T1 0gV 1.59 (±0.88)",
+            "SMC T1 6.5gV 1.61 (±1.11)",
+            "SMC T1 13.5gV 3.42 (±0.78)",
+        ],
+        "start at 1 of the supply": [
+            "within 20 % 18 of 21, SSE ranges within 9 of 13",
+            "PVA T1 1.86 (±0.49)",
+            "PVA T2 2.88",
+            "PVA T3 2.97",
+            "FF+PVA T1 1.52 (±0.53)",
+            "FF+PVA T2 2.45",
+            "FF+PVA T3 2.41",
+            "FF+PVA T4 2.00",
+            "SMC T1 1.35 (±0.50)",
+            "SMC T2 2.32",
+            "SMC T3 2.19",
+            "SMC T4 1.77",
+            "FF+PVA T1 6.5gH 1.48 (±0.50)",
+            "FF+PVA T1 13.5gH 1.88 (±0.40)",
+            "FF+PVA T1 0gV 1.62 (±1.65)",
+            "FF+PVA T1 6.5gV 1.82 (±1.28)",
+            "FF+PVA T1 13.5gV 3.97 (±1.35)",
+            "SMC T1 6.5gH 1.36 (±0.54)",
+            "SMC T1 13.5gH 1.45 (±0.48)",
+            "SMC T1 0gV 1.58 (±0.88)",
+            "SMC T1 6.5gV 1.59 (±1.11)",
+            "SMC T1 13.5gV 3.36 (±0.67)",
+        ],
+    }
+    assert out[7:] == [  # T3's cells from each start: the blind prediction's, committed preset, seeds 0-4
+        "T3 from 0 of the supply (FF+PVA / SMC): "
+        "0gH 2.38 / 2.21 | 6.5gH 2.64 / 2.40 | 13.5gH 2.85 / 2.56 | 0gV 2.36 / 2.20 | 6.5gV 2.69 / 2.44 | 13.5gV 3.61 / 3.42 | SMC ahead on 6 of 6",
+        "T3 from 0.25 of the supply (FF+PVA / SMC): "
+        "0gH 2.38 / 2.18 | 6.5gH 2.63 / 2.38 | 13.5gH 2.88 / 2.60 | 0gV 2.40 / 2.23 | 6.5gV 2.68 / 2.45 | 13.5gV 3.73 / 3.45 | SMC ahead on 6 of 6",
+        "T3 from 0.5 of the supply (FF+PVA / SMC): "
+        "0gH 2.38 / 2.21 | 6.5gH 2.58 / 2.42 | 13.5gH 2.86 / 2.61 | 0gV 2.33 / 2.22 | 6.5gV 2.60 / 2.41 | 13.5gV 3.66 / 3.42 | SMC ahead on 6 of 6",
+        "T3 from 0.75 of the supply (FF+PVA / SMC): "
+        "0gH 2.36 / 2.25 | 6.5gH 2.73 / 2.42 | 13.5gH 2.99 / 2.61 | 0gV 2.36 / 2.26 | 6.5gV 2.68 / 2.42 | 13.5gV 3.77 / 3.38 | SMC ahead on 6 of 6",
+        "T3 from 1 of the supply (FF+PVA / SMC): "
+        "0gH 2.41 / 2.19 | 6.5gH 2.60 / 2.44 | 13.5gH 3.00 / 2.64 | 0gV 2.37 / 2.27 | 6.5gV 2.70 / 2.45 | 13.5gV 3.71 / 3.47 | SMC ahead on 6 of 6",
+    ]
