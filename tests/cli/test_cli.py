@@ -116,6 +116,7 @@ def _trace(tmp_path, *args):
     assert proc.returncode == 0, proc.stderr
     with open(tmp_path / "t.csv", newline="") as handle:
         rows = list(csv.DictReader(handle))
+    assert len(rows) == 1000  # T2's second, one row per 1 ms tick: a check on every row is not a check on none
     return np.array([float(r["y_measured_mm"]) - float(r["y_mm"]) for r in rows])
 
 

@@ -25,6 +25,11 @@ def test_every_registered_experiment_implements_the_interface(name, experiment):
 
 @pytest.mark.parametrize("command,registry", [("whatif", WHATIFS), ("study", STUDIES)])
 def test_the_cli_offers_exactly_the_registered_experiments(command, registry, capsys):
+    from twin.cli import build_parser
+
+    group = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction)).choices[command]
+    offered = next(a for a in group._actions if isinstance(a, argparse._SubParsersAction)).choices
+    assert list(offered) == list(registry)  # each one, no other, in the registry's order
     with pytest.raises(SystemExit):
         main([command, "--help"])
     shown = capsys.readouterr().out

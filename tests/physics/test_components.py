@@ -54,6 +54,24 @@ def test_observer_acceleration_of_a_ramp_converges_to_zero():
     assert np.max(np.abs(a[300:])) < 1e-6
 
 
+def test_observer_acceleration_of_a_parabola_converges_to_its_curvature():
+    """The same filter applied to v_hat: for y = c t^2 / 2, v_hat -> c t (lagged) and a_hat -> c."""
+    curvature = 0.063  # m/s^2, T1's largest reference acceleration
+    t = np.arange(600) * DT
+    _, a = _observe(curvature * t**2 / 2)
+    assert a[500:] == pytest.approx(curvature, rel=1e-6)
+
+
+@pytest.mark.parametrize("omega", [math.pi, 100.0])
+def test_observer_acceleration_of_a_sine_follows_the_transfer_applied_twice(omega):
+    amplitude, gain = 5e-3, 100.0
+    t = np.arange(int(round(10.0 / DT))) * DT
+    _, a = _observe(amplitude * np.sin(omega * t), gain)
+    steady = a[t > 10.0 - 2 * 2 * math.pi / omega - 1e-9]
+    expected = abs(gain * 1j * omega / (1j * omega + gain)) ** 2 * amplitude  # (K s / (s + K))^2 on y
+    assert np.max(np.abs(steady)) == pytest.approx(expected, rel=0.02)
+
+
 @pytest.mark.parametrize("omega", [math.pi, 100.0])  # T3's 0.5 Hz, and the corner frequency
 def test_observer_sine_amplitude_follows_the_continuous_transfer(omega):
     amplitude, gain = 5e-3, 100.0

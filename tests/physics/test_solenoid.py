@@ -62,11 +62,14 @@ def test_shut_it_passes_nothing_and_coil_off_keeps_it_shut():
 
 
 def test_a_full_pulse_gives_the_thesis_delays_within_1_ms():
+    """The issue's bar. The delays are among what ``valve_fit`` aimed the parameters at, so this checks that the
+    committed values still reach the fit's targets; it is not a prediction of the valve."""
     opening, closing = solenoid.delays(P, h=H)
     assert abs(opening - 5e-3) <= 1e-3 and abs(closing - 2e-3) <= 1e-3
 
 
 def test_a_pulse_under_the_dead_zone_lifts_nothing_and_passes_no_flow():
+    """The issue's bar; no lift from a 25 % pulse is one of ``valve_fit``'s targets (see the delays' test)."""
     ticks = int(round(NOMINAL_PARAMS.valves.pwm_period / H))
     states, _ = solenoid.simulate(P, solenoid.coil_command(25.0, ticks), h=H, periods=5,
                                   inertance_time=RIG.inertance_time)
@@ -75,6 +78,7 @@ def test_a_pulse_under_the_dead_zone_lifts_nothing_and_passes_no_flow():
 
 
 def test_the_replica_follows_eq_4_4_2_within_15_percent_from_35_to_100_percent():
+    """The issue's bar, on the duties ``valve_fit`` fitted R(d) at (see the delays' test)."""
     outcome = valve.valve_study()
     ratios = {r["duty_pct"]: r["resistance_twin_pa_s_per_m3"] / r["resistance_eq442_pa_s_per_m3"]
               for r in outcome.rows}

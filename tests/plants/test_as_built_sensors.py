@@ -163,10 +163,18 @@ def test_same_seed_same_map_other_seed_different():
     assert not np.allclose(first, other)
 
 
-@pytest.mark.parametrize(("base", "stroke"), [(-1.0, STROKE), (3.6, (5e-3, 5e-3)), (3.6, (0.0, math.inf))])
-def test_stiction_map_rejects_bad_arguments(base, stroke):
-    with pytest.raises(InvalidParameter):
-        StictionMap(StictionMapParams(scatter=1.0), base, stroke)
+@pytest.mark.parametrize(("base", "stroke", "said"), [(-1.0, STROKE, "base stiction"),
+                                                     (3.6, (5e-3, 5e-3), "stroke must be"),
+                                                     (3.6, (0.0, math.inf), "stroke must be")])
+def test_stiction_map_rejects_bad_arguments(base, stroke, said):
+    # seeded, so that the refusal is the one for the bad argument, not the one for a missing seed
+    with pytest.raises(InvalidParameter, match=said):
+        StictionMap(StictionMapParams(scatter=1.0, seed=0), base, stroke)
+
+
+def test_a_stiction_map_without_a_seed_is_refused():
+    with pytest.raises(InvalidParameter, match="needs a seed"):
+        StictionMap(StictionMapParams(scatter=1.0), 3.6, STROKE)
 
 
 def test_stiction_maps_evaluate_each_runs_own_map():
