@@ -148,6 +148,27 @@ def test_blocked_chamber_with_free_air_fills_as_its_closed_form(air_fraction):
     assert with_air / water_only > 10
 
 
+def test_a_chamber_pulled_open_stops_at_the_vapour_floor():
+    """Sealed chambers, viscous friction only, the rack pulled outwards from chamber A with 20 N (1.6 MPa over
+    the bore, far past the 0.1 MPa that takes chamber A to absolute zero): water cannot pull below its vapour
+    pressure, so P_a falls to the floor (VAPOUR_MARGIN above absolute zero), is held exactly there, and never
+    goes below it."""
+    from twin.physics.chambers import VAPOUR_MARGIN
+
+    pull, floor = 20.0, VAPOUR_MARGIN - ChamberParams().atmospheric_pressure  # N; Pa, gauge
+    circuit = make_circuit(initial_pressure=0.0, friction_params=FrictionParams(coulomb_poly=(0.0,), stiction=0.0))
+    y, v, stuck = np.array([7.0e-3]), np.zeros(1), np.zeros(1, dtype=bool)
+    pressures = []
+    for _ in range(20):
+        forces = circuit.tick(conductance=conductances(), y=y, v0=v, external_force=np.array([pull]), stuck=stuck,
+                              mass=np.array([HEAVY]), h=H, breakaway=constant(0.0))
+        v, stuck = forces.velocity, forces.stuck
+        y = y + H * v
+        pressures.append(circuit.state.pressure_a[0])
+    assert min(pressures) == floor  # reached, held, and never below
+    assert pressures[0] == floor  # at once: 20 N would take the sealed water below it within the first tick
+
+
 # --------------------------------------------------------------------------- 2. hydraulic natural frequency
 
 
