@@ -1,12 +1,16 @@
 """``twin`` and ``python -m twin``: the command line (:mod:`twin.cli`), loaded inside the Ctrl-C guard so an
 interrupt while it loads is one line too, not a traceback."""
 
+import os
 import sys
 
 EXIT_INTERRUPTED = 130  # twin.cli.common's, not imported: this must not load the command line first
 
 
 def entry() -> int:
+    for name in ("stdout", "stderr"):  # started with one closed (``2>&-``): progress and messages go nowhere
+        if getattr(sys, name) is None:
+            setattr(sys, name, open(os.devnull, "w"))  # open for the life of the process
     try:
         from twin.cli import main
     except KeyboardInterrupt:

@@ -15,6 +15,8 @@ import html
 import importlib.resources
 import json
 import pathlib
+import re
+import uuid
 from collections.abc import Sequence
 
 import numpy as np
@@ -112,10 +114,28 @@ def compare_label(text: dict) -> str:
     return ", ".join(f"{key}={value}" for key, value in text.items())
 
 
+UUID = re.compile(r"[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}")
+
+
+def stable_uuids(command, renamed: dict[str, str]):
+    """``command`` with every UUID meshcat gave it (``uuid1``: the time it was made and this machine's network
+    address) renamed in order of first appearance, the same name wherever it is referred to: a recording is
+    then the same bytes for the same run, and says nothing of where or when it was made. ``renamed`` carries
+    the names across one page's commands."""
+    if isinstance(command, dict):
+        return {key: stable_uuids(value, renamed) for key, value in command.items()}
+    if isinstance(command, list | tuple):
+        return type(command)(stable_uuids(value, renamed) for value in command)
+    if isinstance(command, str) and UUID.fullmatch(command):
+        return renamed.setdefault(command, str(uuid.UUID(int=len(renamed) + 1)))
+    return command
+
+
 def page(*, title: str, commands: Sequence[dict], rows: Sequence[TraceRows], labels: Sequence[str]) -> str:
     """The HTML text of a recording of ``commands`` (scene + animation) and its traces ``rows`` (the
     first joint's, and the second's in compare mode), named by ``labels`` in the charts' legend."""
-    packed = [base64.b64encode(umsgpack.packb(c)).decode("ascii") for c in commands]
+    renamed: dict[str, str] = {}
+    packed = [base64.b64encode(umsgpack.packb(stable_uuids(c, renamed))).decode("ascii") for c in commands]
     traces = [r.as_json() for r in rows]
     return (PAGE.read_text()
             .replace("{{title}}", html.escape(title))

@@ -1048,3 +1048,79 @@ def test_a_killed_pool_leaves_no_thread_running_into_the_exit():
     sweep.kill_pool(pool)
     assert not manager.is_alive()
     assert all(not p.is_alive() for p in (pool._processes or {}).values())
+
+
+@pytest.mark.parametrize("stop", ["SIGTERM", "SIGHUP"])
+def test_a_kill_or_a_closed_terminal_while_twin_run_writes_leaves_nothing(tmp_path, capsys, monkeypatch, stop):
+    """`twin run` ran outside the SIGTERM guard that other commands have: a kill while it wrote left a
+    half-written hidden temporary beside its outputs and exit 143, with no word (a helper's probe, stop 40).
+    Every command now runs inside it, and a closed terminal (SIGHUP) stops as Ctrl-C does too."""
+    from twin.sim import report
+
+    def write_trace(result, path):
+        pathlib.Path(path).write_text("t_s,theta_deg\n0,30\n")  # part of the trace on disk
+        os.kill(os.getpid(), getattr(signal, stop))
+        time.sleep(5)  # the signal arrives first
+        raise AssertionError(f"{stop} did not stop the run")
+
+    class Unhandled(Exception):
+        pass
+
+    def sentinel(number, frame):  # stands in for "no handler": without the fix this fails the test, not pytest
+        raise Unhandled
+
+    monkeypatch.setattr(report, "write_trace", write_trace)
+    signum = getattr(signal, stop)
+    before = signal.signal(signum, sentinel)
+    try:
+        argv = ["run", "--controller", "ffpva", "--trajectory", "2", "--trace", str(tmp_path / "t.csv"),
+                "--plot", str(tmp_path / "p.png")]
+        assert main(argv) == 130
+        assert capsys.readouterr().err.strip().splitlines()[-1] == "twin: interrupted"
+        assert list(tmp_path.iterdir()) == []  # no output, no temporary
+        assert signal.getsignal(signum) is sentinel  # put back afterwards
+    finally:
+        signal.signal(signum, before)
+
+
+def test_a_closed_stdout_after_the_outputs_are_written_is_not_called_bad_input(tmp_path, monkeypatch):
+    """`twin run --json | true`: every output written, then 'twin: error: [Errno 32] Broken pipe' and exit 2,
+    the code for bad input with nothing written (a helper's probe, stop 40). Now 141, as a shell reports a
+    reader that went away, and no message."""
+    read, write = os.pipe()
+    os.close(read)  # the reader is gone before the first line
+    script = ("import sys; from twin.cli import main; "
+              f"sys.exit(main(['run', '--controller', 'ffpva', '--trajectory', '2', '--json', '--trace', "
+              f"{str(tmp_path / 't.csv')!r}]))")
+    proc = subprocess.run([sys.executable, "-c", script], stdout=write, stderr=subprocess.PIPE, text=True, timeout=300)
+    os.close(write)
+    assert proc.returncode == 141, proc.stderr
+    assert "Broken pipe" not in proc.stderr and "error" not in proc.stderr
+    assert (tmp_path / "t.csv").stat().st_size > 10_000  # the trace is whole
+
+
+def test_a_grid_file_over_1_mb_is_refused_without_reading_it_all(tmp_path):
+    """`twin sweep --config /dev/zero` read until the kernel killed it (24 GB in 10 s; a helper's probe, stop
+    40). Now it reads at most 1 MB. (Checked on a 2 MB file, not on /dev/zero: without the fix that would
+    take the machine's memory, not fail.)"""
+    from twin.batch import grid
+    from twin.exceptions import InvalidScenario
+
+    big = tmp_path / "big.toml"
+    big.write_text("seed = [0]\n" + "# padding\n" * 200_000)
+    with pytest.raises(InvalidScenario, match="over 1 MB: not a grid"):
+        grid.read_toml(big)
+    small = tmp_path / "small.toml"
+    small.write_text("seed = [0, 1]\n")
+    assert grid.read_toml(small) == {"seed": [0, 1]}
+
+
+def test_a_command_started_with_its_error_stream_closed_still_runs(tmp_path):
+    """`twin whatif gear-load --out DIR 2>&-` exited 1 with no word and removed its folder: the progress bar
+    wrote to a missing stderr (a helper's probe, stop 40). Now both streams fall back to /dev/null."""
+    script = "import sys; from twin.__main__ import entry; sys.exit(entry())"
+    proc = subprocess.run([sys.executable, "-c", script, "whatif", "gear-load", "--out", str(tmp_path / "g")],
+                          stdin=subprocess.DEVNULL, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
+                          timeout=300, close_fds=True, pass_fds=(), preexec_fn=lambda: os.close(2))
+    assert proc.returncode == 0
+    assert (tmp_path / "g").is_dir() and any((tmp_path / "g").iterdir())

@@ -181,6 +181,29 @@ def test_recording_writes_one_offline_file(tmp_path):
     assert trace["angle_deg"][-1] == pytest.approx(math.degrees(result.trace.angle[-1]), abs=1e-9)
 
 
+def test_a_recording_is_the_same_bytes_for_the_same_run_and_names_no_machine(tmp_path):
+    """meshcat names each object with ``uuid1`` (the time and this machine's network address), so two
+    recordings of one run differed and each carried the address (a helper's probe, stop 40)."""
+    import base64
+    import re
+    import uuid
+
+    import umsgpack
+
+    from viz.recording import write_recording
+
+    result = run(Scenario("ffpva", 2, seed=7))
+    first, second = tmp_path / "a.html", tmp_path / "b.html"
+    write_recording(result, first)
+    write_recording(result, second)
+    assert first.read_bytes() == second.read_bytes()
+    commands = [umsgpack.unpackb(base64.b64decode(c))
+                for c in json.loads(first.read_text().split("const commands = ")[1].split(";\n")[0])]
+    found = set(re.findall(r"[0-9a-f]{8}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{4}-[0-9a-f]{12}", repr(commands)))
+    assert found and all(uuid.UUID(u).version is None for u in found)  # none is uuid1's (version 1)
+    assert f"{uuid.getnode():012x}" not in repr(commands)
+
+
 def test_trace_rows_empty_recording_is_an_empty_table():
     from viz.live_server import _Recorder
 

@@ -325,3 +325,61 @@ def test_the_registered_predictions_are_append_only_and_each_is_its_files():
 def test_a_whole_number_may_have_leading_zeros_of_any_length():
     assert score._whole("0005", "t3.csv line 2", "runs", 2, 1000) == 5
     assert score._whole("0" * 5000 + "7", "t3.csv line 2", "runs", 2, 1000) == 7
+
+
+@pytest.mark.parametrize("name", ["score.csv", "orders.csv", "score.md", "score.png"])
+def test_a_measured_file_that_is_one_of_the_outputs_is_refused_and_kept(tmp_path, capsys, name):
+    """It was replaced by the score table, exit 0: the rig's measurements lost (a helper's probe, stop 40)."""
+    out = tmp_path / "lab"
+    out.mkdir()
+    measured = write_measured(out / name, made_up())
+    before = measured.read_bytes()
+    assert main(["score", "--measured", str(measured), "--out", str(out)]) == 2
+    said = capsys.readouterr().err
+    assert f"is {name}, a file this command writes into" in said and said.count("\n") == 1
+    assert measured.read_bytes() == before and sorted(p.name for p in out.iterdir()) == [name]
+    linked = tmp_path / "elsewhere.csv"  # the same file by another name
+    linked.symlink_to(measured)
+    assert main(["score", "--measured", str(linked), "--out", str(out)]) == 2
+    assert measured.read_bytes() == before
+
+
+def test_a_spreadsheets_blank_rows_and_trailing_commas_are_read_as_the_plain_file(tmp_path, capsys):
+    """A spreadsheet's export: a blank line or a row of empty cells before the header, a trailing comma on
+    every line. Each was a misleading error ("more fields than its header", "names the column(s)  more than
+    once", "has the column(s) , which are not read"; a helper's probe, stop 40); each now scores as the plain
+    file does. A value under a column without a name is still refused."""
+    good = write_measured(tmp_path / "good.csv", made_up())
+    text = good.read_text()
+    assert main(["score", "--measured", str(good), "--out", str(tmp_path / "plain")]) == 0
+    plain = (tmp_path / "plain" / "score.csv").read_bytes()
+    width = text.splitlines()[0].count(",") + 1
+    variants = {"blank.csv": "\n" + text, "empty_row.csv": "," * (width - 1) + "\n" + text,
+                "trailing.csv": "".join(line + ",\n" for line in text.splitlines()),
+                "all.csv": "\n" + "," * width + "\n" + "".join(line + ",,\n" for line in text.splitlines())}
+    for name, content in variants.items():
+        (tmp_path / name).write_text(content)
+        out = tmp_path / name.removesuffix(".csv")
+        assert main(["score", "--measured", str(tmp_path / name), "--out", str(out)]) == 0, capsys.readouterr().err
+        assert (out / "score.csv").read_bytes() == plain, name
+    header, first, *rest = text.splitlines(keepends=True)
+    (tmp_path / "unnamed.csv").write_text(header.rstrip("\n") + ",\n" + first.rstrip("\n") + ",7\n" + "".join(rest))
+    capsys.readouterr()
+    assert main(["score", "--measured", str(tmp_path / "unnamed.csv"), "--out", str(tmp_path / "u")]) == 2
+    err = capsys.readouterr().err
+    assert f"line 2 has a value in column {width + 1}, which has no name in the header" in err and err.count("\n") == 1
+
+
+def test_runs_given_on_some_cells_but_not_others_is_refused(tmp_path, capsys):
+    """A blank runs cell beside rows that say 10 was read as five runs, without a word (a helper's probe,
+    stop 40): refused, as stalled_runs on some cells is."""
+    rows = [{**row, "runs": "10"} for row in made_up()]
+    rows[3]["runs"] = ""
+    measured = write_measured(tmp_path / "t3.csv", rows, columns=(*score.MEASURED_COLUMNS, "runs"))
+    assert main(["score", "--measured", str(measured), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert "gives runs on 11 of the 12 cells" in err and "give it on every cell or on none" in err
+    assert err.count("\n") == 1 and not (tmp_path / "s").exists()
+    rows[3]["runs"] = "10"
+    measured = write_measured(tmp_path / "t3.csv", rows, columns=(*score.MEASURED_COLUMNS, "runs"))
+    assert main(["score", "--measured", str(measured), "--out", str(tmp_path / "s")]) == 0

@@ -100,13 +100,20 @@ def parse_axis(name: str, value) -> list:
     return list(out)
 
 
+CONFIG_MAX_BYTES = 1_000_000  # a grid's TOML is a few lines
+
+
 def read_toml(path) -> dict[str, list]:
     """Axes from a TOML file: top-level keys or a ``[grid]`` table, named like the flags."""
     try:
         with open(path, "rb") as handle:
-            data = tomllib.load(handle)
+            raw = handle.read(CONFIG_MAX_BYTES + 1)  # no more: /dev/zero or a huge file must not fill the memory
     except OSError as error:
         raise InvalidScenario(f"cannot read --config {str(path)!r}: {error.strerror}") from None
+    if len(raw) > CONFIG_MAX_BYTES:
+        raise InvalidScenario(f"--config {str(path)!r} is over {CONFIG_MAX_BYTES // 1_000_000} MB: not a grid")
+    try:
+        data = tomllib.loads(raw.decode("utf-8"))
     except ValueError as error:  # TOMLDecodeError, or bytes that are not UTF-8
         raise InvalidScenario(f"--config {str(path)!r} is not valid TOML: {error}") from None
     table = data.get("grid", data)

@@ -206,6 +206,7 @@ def worker_setup() -> None:
     parent = os.getppid()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's Ctrl-C stand-in: a SIGTERM just ends a worker
+    signal.signal(signal.SIGHUP, signal.SIG_DFL)  # likewise when the terminal closes
     try:
         import ctypes
 

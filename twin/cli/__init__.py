@@ -18,12 +18,14 @@ parser (``add_parser``).
 from __future__ import annotations
 
 import argparse
+import os
 import sys
 
 from twin.cli import bench, calibrate, demo, experiments, run, score, sweep, validate, view
-from twin.cli.common import EXIT_INTERRUPTED, EXIT_USAGE, Parser
+from twin.cli.common import EXIT_INTERRUPTED, EXIT_USAGE, Parser, sigterm_as_interrupt
 from twin.exceptions import TwinError
 
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a reader that went away
 COMMANDS = (demo, bench, sweep, experiments, run, calibrate, validate, score, view)
 
 
@@ -42,7 +44,11 @@ def main(argv: list[str] | None = None) -> int:
         if extra:  # named after the command they were given to, as every other parse error is
             command = " ".join(filter(None, (args.command, getattr(args, "experiment", None))))
             parser.exit(EXIT_USAGE, f"twin: error: {command}: unrecognized arguments: {' '.join(extra)}\n")
-        return args.func(args)
+        with sigterm_as_interrupt():  # every command: a kill or a closed terminal cleans up as Ctrl-C does
+            return args.func(args)
+    except BrokenPipeError:  # whoever read our output has gone (``| head``): what was written is whole
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit's flush
+        return EXIT_BROKEN_PIPE
     except KeyboardInterrupt:  # Ctrl-C where a command has nothing of its own to say: one line, no traceback
         print("twin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

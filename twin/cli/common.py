@@ -141,19 +141,24 @@ def scenario_from(args: argparse.Namespace) -> Scenario:
     )
 
 
+STOPPED_AS_CTRL_C = (signal.SIGTERM, signal.SIGHUP)  # besides Ctrl-C itself
+
+
 @contextlib.contextmanager
 def sigterm_as_interrupt():
-    """SIGTERM (``kill``, a job scheduler) stops the ``with`` block as Ctrl-C does, so the same clean-up
-    runs; the previous handler afterwards. Only the main thread may set handlers: elsewhere a no-op."""
+    """SIGTERM (``kill``, a job scheduler) and SIGHUP (the terminal or ssh session closed) stop the ``with``
+    block as Ctrl-C does, so the same clean-up runs; the previous handlers afterwards. Only the main thread may
+    set handlers: elsewhere a no-op."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = signal.signal(signal.SIGTERM, signal.default_int_handler)
+    previous = {signum: signal.signal(signum, signal.default_int_handler) for signum in STOPPED_AS_CTRL_C}
     try:
         yield
     finally:
-        if previous is not None:  # None: a handler set outside Python, which cannot be put back from here
-            signal.signal(signal.SIGTERM, previous)
+        for signum, handler in previous.items():
+            if handler is not None:  # None: a handler set outside Python, which cannot be put back from here
+                signal.signal(signum, handler)
 
 
 @dataclasses.dataclass

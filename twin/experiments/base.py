@@ -151,12 +151,12 @@ def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:
             raise IsADirectoryError(errno.EISDIR, "a folder is in the way of this file", str(out / name))
 
 
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM)
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 @contextlib.contextmanager
 def stops_held():
-    """Hold Ctrl-C and SIGTERM for the block, then put back the handlers they had and deliver each that
+    """Hold Ctrl-C, SIGTERM and SIGHUP for the block, then put back the handlers they had and deliver each that
     came, once, in the order they came (each even when an earlier one's handler raised): for a few
     renames that must all happen or none. A handler set outside Python (``None``) comes back as the
     default. Python runs signal handlers in the main thread only, so outside it this holds nothing."""

@@ -7,8 +7,8 @@ preset), or the one in a ``twin validate`` output folder (``--prediction DIR``).
 on record before the data (:data:`REGISTERED`, by its files' SHA-256): a file changed since, or a refit's new
 prediction, is refused unless ``--unregistered`` is given, and then every output says it is not on record.
 The measurements are a CSV with one row per T3 cell, twelve in all (:data:`MEASURED_COLUMNS`; ``trajectory``,
-``runs`` and ``stalled_runs`` may be left out: T3, five runs, not stated; ``stalled_runs`` on every row or on
-none; no other column)::
+``runs`` and ``stalled_runs`` may be left out: T3, five runs, not stated; ``runs`` and ``stalled_runs`` each on
+every row or on none; no other column)::
 
     controller,payload_g,orientation,rmse_mean_deg,rmse_std_deg
     smc,13.5,vertical,3.1,0.4
@@ -45,6 +45,7 @@ import hashlib
 import importlib.resources
 import io
 import math
+import os
 import pathlib
 
 import numpy as np
@@ -119,26 +120,35 @@ CELL_KEYS = tuple((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # (controller, 
 
 
 def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
-    """A CSV's column names and its rows, each with the line it ends on; blank rows left out. One-line
-    :class:`InvalidScenario` errors for a file that cannot be read or is over :data:`MAX_BYTES`, a repeated
-    column name or a row with more fields than the header. ``path`` may be a package resource."""
+    """A CSV's column names and its rows, each with the line it ends on; blank rows left out, before the
+    header too, and columns without a name whose every cell is blank (a spreadsheet's trailing commas).
+    One-line :class:`InvalidScenario` errors for a file that cannot be read or is over :data:`MAX_BYTES`, a
+    repeated column name, a column without a name that holds values, or a row with more values than the
+    header. ``path`` may be a package resource."""
     try:
         with importlib.resources.as_file(path) as real, open(real, newline="", encoding="utf-8-sig") as handle:
             text = handle.read(MAX_BYTES + 1)
         if len(text) > MAX_BYTES:
             raise InvalidScenario(f"{what} {str(path)!r} is over {MAX_BYTES // 1_000_000} MB: not a table of T3 cells")
-        reader = csv.DictReader(io.StringIO(text, newline=""))
-        columns = [c.strip() for c in reader.fieldnames or []]
+        reader = csv.reader(io.StringIO(text, newline=""))
+        lines = [(reader.line_num, [cell.strip() for cell in row]) for row in reader]
+        lines = [(line, row) for line, row in lines if any(row)]  # blank rows, and rows of empty cells
+        header = lines[0][1] if lines else []
+        columns = [c for c in header if c]
         repeated = sorted({c for c in columns if columns.count(c) > 1})
         if repeated:
             raise InvalidScenario(f"{what} {str(path)!r} names the column(s) {', '.join(repeated)} more than once")
         rows = []
-        for row in reader:
-            if None in row:
-                raise InvalidScenario(f"{what} {str(path)!r} line {reader.line_num} has more fields than its header")
-            cells = {k.strip(): (v or "").strip() for k, v in row.items()}
-            if any(cells.values()):
-                rows.append((reader.line_num, cells))
+        for line, row in lines[1:]:
+            row = row + [""] * (len(header) - len(row))
+            extra = [cell for cell in row[len(header):] if cell]
+            unnamed = [i for i, (name, cell) in enumerate(zip(header, row, strict=False)) if not name and cell]
+            if extra:
+                raise InvalidScenario(f"{what} {str(path)!r} line {line} has more fields than its header")
+            if unnamed:
+                raise InvalidScenario(f"{what} {str(path)!r} line {line} has a value in column {unnamed[0] + 1}, "
+                                      "which has no name in the header")
+            rows.append((line, {name: cell for name, cell in zip(header, row, strict=False) if name}))
         return columns, rows
     except FileNotFoundError:
         raise InvalidScenario(f"{what} {str(path)!r} does not exist") from None
@@ -219,14 +229,20 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
     found: dict[tuple, dict] = {}
     degrees = (f" (degrees, from the Hall sensor's noise, {SMALLEST_MEAN_DEG:g}, to half a turn; radians "
                f"would be about 57 times smaller)")
+    runs_given = []
     for where, key, row in _each_cell(rows, path, found):
         runs = _whole(row.get("runs") or str(THESIS_RUNS), where, "runs", 2, MAX_RUNS)
+        runs_given += [key] if row.get("runs") else []
         stalled = row.get("stalled_runs") or None
         found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG,
                                       high=LARGEST_DEG, hint=degrees),
                       "std": _number(row["rmse_std_deg"], where, "rmse_std_deg", high=LARGEST_DEG), "runs": runs,
                       "stalled": None if stalled is None else _whole(stalled, where, "stalled_runs", 0, runs)}
     _complete(found, f"measured file {str(path)!r}")
+    if runs_given and len(runs_given) != len(found):  # a blank would silently be five beside stated tens
+        blank = next(f"{CONTROLLER_LABELS[c]} {g:g} g {o}" for c, g, o in found if (c, g, o) not in runs_given)
+        raise InvalidScenario(f"measured file {str(path)!r} gives runs on {len(runs_given)} of the 12 cells "
+                              f"(not on {blank}): give it on every cell or on none (five runs)")
     given = [key for key, cell in found.items() if cell["stalled"] is not None]
     if given and len(given) != len(found):
         blank = next(f"{CONTROLLER_LABELS[c]} {g:g} g {o}" for (c, g, o), cell in found.items()
@@ -253,6 +269,14 @@ def registration(folder: pathlib.Path | None = None) -> Registration | None:
     except OSError:
         return None
     return next((r for r in REGISTERED if (r.cells_sha256, r.members_sha256) == digests), None)
+
+
+def _same_file(a: pathlib.Path, b: pathlib.Path) -> bool:
+    """Whether ``a`` and ``b`` are one file (False if either cannot be looked at)."""
+    try:
+        return os.path.samefile(a, b)
+    except (OSError, ValueError, TypeError):
+        return False
 
 
 def read_prediction(folder: pathlib.Path | None = None) -> dict[tuple, dict]:
@@ -500,7 +524,14 @@ class ScoreExperiment(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         """Reads both inputs and the prediction's registration once; :meth:`run` uses them (as other experiments
-        keep what their check parsed on ``args``)."""
+        keep what their check parsed on ``args``). An input that is one of the files this command writes into
+        ``--out`` is refused: the write would replace the rig's measurements (or the prediction) with the score."""
+        inputs = [("--measured", args.measured)] + [("--prediction", path) for path in prediction_files(args.prediction)]
+        for flag, given in inputs:
+            for name in self.file_names():
+                if _same_file(given, args.out / name):
+                    raise InvalidScenario(f"{flag} {str(given)!r} is {name}, a file this command writes into "
+                                          f"{str(args.out)!r}: move it, or choose another --out")
         args.measured_cells = read_measured(args.measured)
         args.predicted_cells = read_prediction(args.prediction)
         args.record = registration(args.prediction)
