@@ -19,7 +19,7 @@ them, not a new prediction: none of these numbers chose anything). With 0.5
 the runs are the committed ones; the script checks that first. It also prints how the committed plant's
 chambers relax from half the supply with every valve shut (the fitted leak and air, seed 0). ``--fresh``
 runs the fresh seeds 40-79 instead and judges, as ``twin validate``'s check does, the mean of the 40 runs and
-X. The result is recorded in
+the mean of the eight five-run groups' SSE ranges (about 6 minutes on 2 cores). The result is recorded in
 docs/investigations.md.
 
     python examples/trial_initial_pressure.py [--fresh]
@@ -124,8 +124,8 @@ def relaxing() -> str:
             return np.zeros(self.n)
 
     trace = simulate([Scenario("pva", 1, plant=plant_starting_at(None), seed=0)], controllers=[Shut()])[0].trace
-    at = [int(np.searchsorted(trace.time, x - 1e-9)) for x in (0.0, 1.0, 2.0, 2.999)]
-    return ", ".join(f"{trace.time[k]:.0f} s {trace.pressure_a[k] / 1e3:.0f} / {trace.pressure_b[k] / 1e3:.0f}"
+    at = [int(np.searchsorted(trace.time, x - 1e-9)) for x in (0.0, 1.0, 2.0, 2.999)]  # 2.999 s: the last tick
+    return ", ".join(f"{trace.time[k]:g} s {trace.pressure_a[k] / 1e3:.0f} / {trace.pressure_b[k] / 1e3:.0f}"
                      for k in at)
 
 

@@ -5,6 +5,7 @@ import os
 import sys
 
 EXIT_INTERRUPTED = 130  # twin.cli.common's, not imported: this must not load the command line first
+EXIT_BROKEN_PIPE = 141  # twin.cli's
 
 
 def entry() -> int:
@@ -16,7 +17,15 @@ def entry() -> int:
     except KeyboardInterrupt:
         print("twin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED
-    return main()
+    code = main()
+    if code == EXIT_BROKEN_PIPE:  # the reader of stdout went away: the exit's flush must not fail again
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+            os.close(devnull)
+        except (OSError, ValueError):
+            pass
+    return code
 
 
 if __name__ == "__main__":

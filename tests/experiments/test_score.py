@@ -383,3 +383,14 @@ def test_runs_given_on_some_cells_but_not_others_is_refused(tmp_path, capsys):
     rows[3]["runs"] = "10"
     measured = write_measured(tmp_path / "t3.csv", rows, columns=(*score.MEASURED_COLUMNS, "runs"))
     assert main(["score", "--measured", str(measured), "--out", str(tmp_path / "s")]) == 0
+
+
+def test_a_row_shorter_than_its_header_is_named_as_such(tmp_path, capsys):
+    """It was padded with blanks, and the error named a cell with no orientation ("sliding mode 13.5 g  ...";
+    a review, stop 40)."""
+    good = write_measured(tmp_path / "good.csv", made_up())
+    header, first, *rest = good.read_text().splitlines(keepends=True)
+    (tmp_path / "short.csv").write_text(header + "smc,13.5\n" + "".join(rest))
+    assert main(["score", "--measured", str(tmp_path / "short.csv"), "--out", str(tmp_path / "s")]) == 2
+    err = capsys.readouterr().err
+    assert "line 2 has fewer fields than its header (2 of 5)" in err and err.count("\n") == 1

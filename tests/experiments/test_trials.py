@@ -761,7 +761,7 @@ def test_trial_initial_pressure_prints_what_investigations_md_quotes(capsys):
     out = capsys.readouterr().out.splitlines()
     assert out[0] == ("as-built preset 1c2dcd8c9f7f (committed), seeds 0-4; chambers starting at 0.5 of the supply "
                       "give the committed runs bit for bit: True")
-    assert out[1] == "shut from half the supply, chambers A / B (kPa): 0 s 150 / 150, 1 s 98 / 106, 2 s 72 / 83, 3 s 57 / 67"
+    assert out[1] == "shut from half the supply, chambers A / B (kPa): 0 s 150 / 150, 1 s 98 / 106, 2 s 72 / 83, 2.999 s 57 / 67"
     rows = {line.split(": ", 1)[0]: line.split(": ", 1)[1].split(" | ") for line in out[2:9]}
     # variant -> cells within 20 % and SSE ranges within ±0.5 deg, then each cell's mean RMSE (and T1's SSE range)
     assert rows == {

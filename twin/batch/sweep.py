@@ -206,7 +206,8 @@ def worker_setup() -> None:
     parent = os.getppid()
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, signal.SIG_DFL)  # not the parent's Ctrl-C stand-in: a SIGTERM just ends a worker
-    signal.signal(signal.SIGHUP, signal.SIG_DFL)  # likewise when the terminal closes
+    if signal.getsignal(signal.SIGHUP) is not signal.SIG_IGN:  # likewise when the terminal closes (unless
+        signal.signal(signal.SIGHUP, signal.SIG_DFL)  # ``nohup``: then the parent ignores it, and so do they)
     try:
         import ctypes
 

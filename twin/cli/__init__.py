@@ -18,7 +18,6 @@ parser (``add_parser``).
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 
 from twin.cli import bench, calibrate, demo, experiments, run, score, sweep, validate, view
@@ -46,9 +45,8 @@ def main(argv: list[str] | None = None) -> int:
             parser.exit(EXIT_USAGE, f"twin: error: {command}: unrecognized arguments: {' '.join(extra)}\n")
         with sigterm_as_interrupt():  # every command: a kill or a closed terminal cleans up as Ctrl-C does
             return args.func(args)
-    except BrokenPipeError:  # whoever read our output has gone (``| head``): what was written is whole
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # no second error at exit's flush
-        return EXIT_BROKEN_PIPE
+    except BrokenPipeError:  # whoever read our output has gone (``| head``): what was written is whole; the
+        return EXIT_BROKEN_PIPE  # process's entry point (twin.__main__) keeps its exit from a second error
     except KeyboardInterrupt:  # Ctrl-C where a command has nothing of its own to say: one line, no traceback
         print("twin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -147,12 +147,14 @@ STOPPED_AS_CTRL_C = (signal.SIGTERM, signal.SIGHUP)  # besides Ctrl-C itself
 @contextlib.contextmanager
 def sigterm_as_interrupt():
     """SIGTERM (``kill``, a job scheduler) and SIGHUP (the terminal or ssh session closed) stop the ``with``
-    block as Ctrl-C does, so the same clean-up runs; the previous handlers afterwards. Only the main thread may
-    set handlers: elsewhere a no-op."""
+    block as Ctrl-C does, so the same clean-up runs; the previous handlers afterwards. A signal the process
+    was started ignoring (``nohup`` ignores SIGHUP) stays ignored. Only the main thread may set handlers:
+    elsewhere a no-op."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
-    previous = {signum: signal.signal(signum, signal.default_int_handler) for signum in STOPPED_AS_CTRL_C}
+    previous = {signum: signal.signal(signum, signal.default_int_handler) for signum in STOPPED_AS_CTRL_C
+                if signal.getsignal(signum) is not signal.SIG_IGN}  # ignored (``nohup``): left ignored
     try:
         yield
     finally:

@@ -164,7 +164,8 @@ def stops_held():
         yield
         return
     caught: list[int] = []
-    before = {signum: signal.signal(signum, lambda signum, _frame: caught.append(signum)) for signum in STOP_SIGNALS}
+    before = {signum: signal.signal(signum, lambda signum, _frame: caught.append(signum)) for signum in STOP_SIGNALS
+              if signal.getsignal(signum) is not signal.SIG_IGN}  # an ignored one (``nohup``) stays ignored
     try:
         yield
     finally:

@@ -124,7 +124,7 @@ def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
     header too, and columns without a name whose every cell is blank (a spreadsheet's trailing commas).
     One-line :class:`InvalidScenario` errors for a file that cannot be read or is over :data:`MAX_BYTES`, a
     repeated column name, a column without a name that holds values, or a row with more values than the
-    header. ``path`` may be a package resource."""
+    header or fewer fields than its named columns. ``path`` may be a package resource."""
     try:
         with importlib.resources.as_file(path) as real, open(real, newline="", encoding="utf-8-sig") as handle:
             text = handle.read(MAX_BYTES + 1)
@@ -139,7 +139,11 @@ def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
         if repeated:
             raise InvalidScenario(f"{what} {str(path)!r} names the column(s) {', '.join(repeated)} more than once")
         rows = []
+        named = max((i + 1 for i, name in enumerate(header) if name), default=0)
         for line, row in lines[1:]:
+            if len(row) < named:  # padding it would name a wrong cell ("no T3 cell sliding mode 13.5 g  ...")
+                raise InvalidScenario(f"{what} {str(path)!r} line {line} has fewer fields than its header "
+                                      f"({len(row)} of {named})")
             row = row + [""] * (len(header) - len(row))
             extra = [cell for cell in row[len(header):] if cell]
             unnamed = [i for i, (name, cell) in enumerate(zip(header, row, strict=False)) if not name and cell]
