@@ -54,7 +54,8 @@ def _number(message: dict, field: str, low: float, high: float, unit: str) -> fl
     except OverflowError:  # an integer too large for a float
         number = math.inf
     if math.isnan(number):
-        raise BadMessage(f"{message['type']}: {field} must be a number, got {str(value)[:40]!r}")
+        got = ("nothing (a browser sends Infinity and NaN as null)" if value is None else repr(str(value)[:40]))
+        raise BadMessage(f"{message['type']}: {field} must be a number, got {got}")
     if not low <= number <= high:
         raise BadMessage(f"{message['type']}: {field} must be in [{low:g}, {high:g}] {unit}, got {str(value)[:40]}")
     return number

@@ -170,12 +170,23 @@ class StripCharts {
           ctx.beginPath();
           let started = false;
           const time = tr.time;
-          const step = Math.max(1, Math.floor(time.length / (2 * width)));  // at most ~2 points a pixel
-          for (let i = 0; i < time.length; i += step) {
+          const line = (x, y) => { if (started) ctx.lineTo(x, y); else { ctx.moveTo(x, y); started = true; } };
+          // Each pixel column draws its samples' lowest and highest value, in the order they came: a long
+          // run keeps its peaks (every n-th sample hid them: 0.45 deg drawn of a 0.66 deg largest error).
+          let column = null, low = 0, high = 0, lowFirst = true;
+          const flush = () => {
+            if (column === null) return;
+            line(column, yOf(lowFirst ? low : high));
+            if (high !== low) line(column, yOf(lowFirst ? high : low));
+          };
+          for (let i = 0; i < time.length; i++) {
             if (time[i] < t0 - 0.05 || time[i] > t1 + 0.05) continue;
-            const x = xOf(time[i]), y = yOf(ys[i]);
-            if (started) ctx.lineTo(x, y); else { ctx.moveTo(x, y); started = true; }
+            const x = Math.round(xOf(time[i])), v = ys[i];
+            if (x !== column) { flush(); column = x; low = high = v; lowFirst = true; continue; }
+            if (v < low) { low = v; lowFirst = false; }
+            if (v > high) { high = v; lowFirst = true; }
           }
+          flush();
           ctx.stroke();
         }
       });
@@ -195,17 +206,19 @@ class StripCharts {
   }
 
   // The legend, right-aligned between ``leftmost`` (the title's end) and ``right``: in a smaller font when
-  // it does not fit, and only then without its last items (the first series, as chamber A, stays).
+  // it does not fit, and only then without its last series (the first series, as chamber A, stays; so does
+  // the compare joint's entry, named "compare" here: the page's title and info say what it is).
   _legend(ctx, spec, count, right, y, leftmost = 0) {
     ctx.textAlign = "right";
     ctx.textBaseline = "alphabetic";
     let x = right;
     const items = [];
     for (const s of spec.series) items.push([s.label, s.color, s.dash || []]);
-    if (count > 1) items.push([this.labels[1] || "compare", TWIN_COMPARE_TINT, [5, 3]]);
+    const kept = count > 1 ? 2 : 1;  // the first series, and the compare entry when there is one
+    if (count > 1) items.push(["compare", TWIN_COMPARE_TINT, [5, 3]]);
     const needs = () => items.reduce((w, [label]) => w + ctx.measureText(label).width + 23, 0);
     for (let size = 9; size >= 8 && needs() > right - leftmost; size--) ctx.font = `${size}px sans-serif`;
-    while (items.length > 1 && needs() > right - leftmost) items.pop();
+    while (items.length > kept && needs() > right - leftmost) items.splice(items.length - kept, 1);
     for (const [label, color, dash] of items.reverse()) {
       if (x - ctx.measureText(label).width - 20 < leftmost) break;  // no room even for one: the title stays readable
       ctx.fillStyle = "#333";

@@ -86,6 +86,7 @@ def test_noise_blocks_continue_deterministically(monkeypatch):
     ('{"type": "target", "angle_deg": -1}', "[0, 180] deg"),
     ('{"type": "target", "angle_deg": true}', "must be a number"),
     ('{"type": "target", "angle_deg": NaN}', "must be a number"),
+    ('{"type": "target", "angle_deg": null}', "got nothing (a browser sends Infinity and NaN as null)"),
     ('{"type": "payload", "grams": 50.5}', "[0, 50] g"),
     ('{"type": "payload", "grams": -0.1}', "[0, 50] g"),
     ('{"type": "trajectory", "number": 5}', "1, 2, 3 or 4"),

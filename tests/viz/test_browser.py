@@ -444,3 +444,58 @@ def test_a_live_joint_on_its_side_beside_another_is_framed_and_its_charts_read(p
         proc.kill()
         proc.wait(10)
         log.close()
+
+
+@pytest.mark.slow  # a live twin and a page: about 10 s on 2 cores
+def test_arrow_keys_on_the_target_slider_lose_no_step_and_meshcats_menu_stays_off_the_controls(live_twin, page):
+    """Found by a helper in chromium (stop 40). Arrow keys on the slider lost steps: the twin's echo of an
+    older step put the slider back, and the next step started from there (40 steps up from 90 ended at 118).
+    meshcat's "Open Controls" menu sat at the page's top right, over the controller menu and the slider."""
+    _, url, _ = live_twin
+    page.set_viewport_size({"width": 1280, "height": 720})
+    page.goto(url)
+    page.wait_for_function("window.twinLast !== null && window.twinState !== undefined", timeout=60_000)
+    page.evaluate("window.twinSend({type: 'target', angle_deg: 90})")
+    page.wait_for_function("Math.round(window.twinState.target_deg) === 90", timeout=30_000)
+    page.focus("#target")
+    for _ in range(40):
+        page.keyboard.press("ArrowRight")
+        page.wait_for_timeout(20)
+    page.wait_for_function("Math.round(window.twinState.target_deg) === 130", timeout=30_000)
+    assert slider(page) == 130.0
+    for _ in range(40):
+        page.keyboard.press("ArrowLeft")
+        page.wait_for_timeout(20)
+    page.wait_for_function("Math.round(window.twinState.target_deg) === 90", timeout=30_000)
+    page.wait_for_timeout(1200)  # past the slider's wait for an echo: it follows the twin again, and agrees
+    assert slider(page) == 90.0
+    # meshcat's menu, opened, is inside the 3D pane and covers none of the controls
+    page.click("text=Open Controls")
+    page.wait_for_timeout(300)
+    for control in ("#controller", "#target", "#payload", "#orientation"):
+        hit = page.evaluate(f"""(() => {{ const r = document.querySelector('{control}').getBoundingClientRect();
+            const el = document.elementFromPoint(r.left + r.width / 2, r.top + r.height / 2);
+            return el === document.querySelector('{control}') || document.querySelector('{control}').contains(el); }})()""")
+        assert hit, f"{control} is covered"
+
+
+@pytest.mark.slow  # a recording and a page: about 8 s on 2 cores
+def test_space_plays_a_recording_after_the_scrub_bar_was_used(tmp_path, page):
+    """The scrub bar keeps the focus after a drag, and Space then did nothing (a helper in chromium, stop 40)."""
+    html = tmp_path / "out.html"
+    proc = subprocess.run([sys.executable, "-m", "twin", "run", "--controller", "ffpva", "--trajectory", "4",
+                           "--html", str(html)], cwd=tmp_path, env=twin_env(), capture_output=True, text=True,
+                          timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    page.goto(html.as_uri())
+    wait_for_animation(page)
+    page.wait_for_function("window.twinClock.playing && window.twinClock.time > 0", timeout=30_000)
+    page.click("#play")  # paused by the page's own button (T4 plays 6 s: it has not ended by now)
+    assert page.evaluate("window.twinClock.playing") is False
+    page.focus("#scrub")
+    page.keyboard.press("Home")
+    assert page.evaluate("document.activeElement.id") == "scrub"
+    page.keyboard.press("Space")
+    assert page.evaluate("window.twinClock.playing") is True
+    page.keyboard.press("Space")
+    assert page.evaluate("window.twinClock.playing") is False
