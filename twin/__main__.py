@@ -5,7 +5,6 @@ import os
 import sys
 
 EXIT_INTERRUPTED = 130  # twin.cli.common's, not imported: this must not load the command line first
-EXIT_BROKEN_PIPE = 141  # twin.cli's
 
 
 def entry() -> int:
@@ -13,7 +12,7 @@ def entry() -> int:
         if getattr(sys, name) is None:
             setattr(sys, name, open(os.devnull, "w"))  # open for the life of the process
     try:
-        from twin.cli import main
+        from twin.cli import EXIT_BROKEN_PIPE, main
     except KeyboardInterrupt:
         print("twin: interrupted", file=sys.stderr)
         return EXIT_INTERRUPTED

@@ -241,31 +241,30 @@ class LiveSession:
 
     def _note_run(self) -> None:
         """Add what the first joint runs now (its controller and plan) to :attr:`runs`, unless it is the last."""
-        state = self.state()
-        run = f"{state['controller']} {state['playing']}"
+        run = f"{self.scenario.controller} {self._playing()}"
         if not self.runs or self.runs[-1] != run:
             self.runs.append(run)
 
     def handle(self, text: str | bytes) -> bool:
         """Apply one message from the page; True if the model was rebuilt. Raises BadMessage."""
         command = live_messages.parse(text)
-        if isinstance(command, live_messages.Target | live_messages.PlayTrajectory | live_messages.SwitchController):
-            if isinstance(command, live_messages.Target):
-                self.joints.set_target(command.angle)
-            elif isinstance(command, live_messages.PlayTrajectory):
-                self.joints.play(command.number)
-            else:
-                self.joints.switch_controller(command.name)
-            self._note_run()
-            return False
-        now = time.monotonic()
-        if now - self._rebuilt_at < MIN_REBUILD_INTERVAL:
-            raise live_messages.BadMessage(f"the model was rebuilt {now - self._rebuilt_at:.1f} s ago: "
-                                           f"wait {MIN_REBUILD_INTERVAL:g} s between payload/orientation changes")
-        changes = {k: v for k, v in dataclasses.asdict(command).items() if v is not None}
-        self._start(dataclasses.replace(self.scenario, **changes))
-        self._rebuilt_at = now
-        return True
+        if isinstance(command, live_messages.Target):
+            self.joints.set_target(command.angle)
+        elif isinstance(command, live_messages.PlayTrajectory):
+            self.joints.play(command.number)
+        elif isinstance(command, live_messages.SwitchController):
+            self.joints.switch_controller(command.name)
+        else:
+            now = time.monotonic()
+            if now - self._rebuilt_at < MIN_REBUILD_INTERVAL:
+                raise live_messages.BadMessage(f"the model was rebuilt {now - self._rebuilt_at:.1f} s ago: "
+                                               f"wait {MIN_REBUILD_INTERVAL:g} s between payload/orientation changes")
+            changes = {k: v for k, v in dataclasses.asdict(command).items() if v is not None}
+            self._start(dataclasses.replace(self.scenario, **changes))
+            self._rebuilt_at = now
+            return True
+        self._note_run()
+        return False
 
     def play(self, number: int) -> None:
         """Replay trajectory ``number`` on every joint (as the page's T buttons do)."""
@@ -284,11 +283,15 @@ class LiveSession:
             message.update(compare_angle_deg=math.degrees(c.angle), compare_duty=c.duty)
         return message
 
+    def _playing(self) -> str:
+        """What the joints' plan is: a trajectory's replay, or a hold at a target."""
+        plan = self.joint.plan
+        return f"T{plan.number}" if plan.number else f"target {math.degrees(self.joints.target()):.0f} deg"
+
     def state(self) -> dict:
-        s, plan = self.scenario, self.joint.plan
+        s = self.scenario
         target = math.degrees(self.joints.target())
-        playing = f"T{plan.number}" if plan.number else f"target {target:.0f} deg"
-        state = {"type": "state", "controller": s.controller, "trajectory": s.trajectory, "playing": playing,
+        state = {"type": "state", "controller": s.controller, "trajectory": s.trajectory, "playing": self._playing(),
                  "target_deg": round(target, 6), "payload_g": s.payload * 1e3, "orientation": s.orientation.value,
                  "plant": s.plant_name, "supply_kpa": s.supply / 1e3, "compare": None}
         second = self.joints.second
@@ -310,11 +313,7 @@ class LiveSession:
         title = f"live: {runs}; {s.payload * 1e3:g} g {s.orientation.value} ({s.plant_name}, seed {s.seed})"
         if self.compare is not None:
             title += f" vs {compare_label(self.compare.text)}"
-        controllers = ", ".join(dict.fromkeys(run.split()[0] for run in self.runs))
-        labels = [f"{controllers}, {s.plant_name}"]
-        if self.compare is not None:
-            labels.append(f"compare: {compare_label(self.compare.text)}")
-        write_page(tmp, scenes=self.scenes, frames=self.recorder.frames, rows=rows, title=title, labels=labels)
+        write_page(tmp, scenes=self.scenes, frames=self.recorder.frames, rows=rows, title=title)
         os.replace(tmp, path)
 
 

@@ -131,9 +131,13 @@ def stable_uuids(command, renamed: dict[str, str]):
     return command
 
 
-def page(*, title: str, commands: Sequence[dict], rows: Sequence[TraceRows], labels: Sequence[str]) -> str:
+TRACE_LABELS = ("first", "compare")  # the charts' names for the traces; the legend shows the second's
+
+
+def page(*, title: str, commands: Sequence[dict], rows: Sequence[TraceRows]) -> str:
     """The HTML text of a recording of ``commands`` (scene + animation) and its traces ``rows`` (the
-    first joint's, and the second's in compare mode), named by ``labels`` in the charts' legend."""
+    first joint's, and the second's in compare mode); the title says what each is."""
+    labels = TRACE_LABELS[:len(rows)]
     renamed: dict[str, str] = {}
     packed = [base64.b64encode(umsgpack.packb(stable_uuids(c, renamed))).decode("ascii") for c in commands]
     traces = [r.as_json() for r in rows]
@@ -148,10 +152,9 @@ def page(*, title: str, commands: Sequence[dict], rows: Sequence[TraceRows], lab
 
 
 def write_page(path: pathlib.Path, *, scenes: Sequence[JointScene], frames: Sequence[Frame],
-               rows: Sequence[TraceRows], title: str, labels: Sequence[str] = ("first", "compare"),
-               fps: int = FPS) -> None:
+               rows: Sequence[TraceRows], title: str, fps: int = FPS) -> None:
     path.write_text(page(title=title, commands=[*scene_commands(scenes), animation_command(frames, fps)],
-                         rows=rows, labels=labels[:len(rows)]))
+                         rows=rows))
 
 
 def title_of(scenario) -> str:
@@ -178,9 +181,7 @@ def write_recording(result: Result, path: pathlib.Path, *, compare: Result | Non
         all_rows.append(rows)
     frames = [Frame.merged(pictures) for pictures in zip(*all_frames, strict=False)]
     title = f"{title_of(result.scenario)}: RMSE {np.degrees(result.metrics.rmse):.2f} deg"
-    labels = ["first"]
     if compare is not None:
         text = compare_label(compare_text or {})
         title += f"; compare {text}: RMSE {np.degrees(compare.metrics.rmse):.2f} deg"
-        labels = [f"{result.scenario.controller}, {result.scenario.plant_name}", f"compare: {text}"]
-    write_page(path, scenes=scenes, frames=frames, rows=all_rows, title=title, labels=labels, fps=fps)
+    write_page(path, scenes=scenes, frames=frames, rows=all_rows, title=title, fps=fps)

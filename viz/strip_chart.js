@@ -23,14 +23,14 @@ const TWIN_CHARTS = [
     {key: "supply_kpa", label: "supply", color: "#555555", dash: [1, 3]}]},
   {id: "valves", title: "valves (open)", unit: "", kind: "valves"},
 ];
-const TWIN_COMPARE_TINT = "#12a5b0";
+const TWIN_COMPARE_TINT = "#12a5b0";  // teal, as the second joint in the 3D view (viz/scene.py COMPARE_TINT)
 
 // A number with ``digits`` decimals, never "-0" (a small negative duty or pressure reads 0): both pages' readouts.
 function twinFixed(x, digits) {
   const text = x.toFixed(digits);
   return Number(text) === 0 ? (0).toFixed(digits) : text;
 }
-const TWIN_CAMERA_FOV = 35;  // deg, vertical field of view of the 3D view  // teal, as the second joint in the 3D view (viz/scene.py COMPARE_TINT)
+const TWIN_CAMERA_FOV = 35;  // deg, vertical field of view of the 3D view
 
 class StripCharts {
   // container: an element to fill with one canvas per chart; labels: a name per trace (legend).
@@ -207,7 +207,7 @@ class StripCharts {
 
   // The legend, right-aligned between ``leftmost`` (the title's end) and ``right``: in a smaller font when
   // it does not fit, and only then without its last series (the first series, as chamber A, stays; so does
-  // the compare joint's entry, named "compare" here: the page's title and info say what it is).
+  // the compare joint's entry, "compare" on both pages: the page's title and info say what it is).
   _legend(ctx, spec, count, right, y, leftmost = 0) {
     ctx.textAlign = "right";
     ctx.textBaseline = "alphabetic";
@@ -215,7 +215,7 @@ class StripCharts {
     const items = [];
     for (const s of spec.series) items.push([s.label, s.color, s.dash || []]);
     const kept = count > 1 ? 2 : 1;  // the first series, and the compare entry when there is one
-    if (count > 1) items.push(["compare", TWIN_COMPARE_TINT, [5, 3]]);
+    if (count > 1) items.push([this.labels[1] || "compare", TWIN_COMPARE_TINT, [5, 3]]);
     const needs = () => items.reduce((w, [label]) => w + ctx.measureText(label).width + 23, 0);
     for (let size = 9; size >= 8 && needs() > right - leftmost; size--) ctx.font = `${size}px sans-serif`;
     while (items.length > kept && needs() > right - leftmost) items.splice(items.length - kept, 1);

@@ -60,4 +60,4 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_USAGE
 
 
-__all__ = ["build_parser", "main"]
+__all__ = ["EXIT_BROKEN_PIPE", "build_parser", "main"]
