@@ -19,7 +19,7 @@ them, not a new prediction: none of these numbers chose anything). With 0.5
 the runs are the committed ones; the script checks that first. It also prints how the committed plant's
 chambers relax from half the supply with every valve shut (the fitted leak and air, seed 0). ``--fresh``
 runs the fresh seeds 40-79 instead and judges, as ``twin validate``'s check does, the mean of the 40 runs and
-the mean of the eight five-run groups' SSE ranges (about 6 minutes on 2 cores). The result is recorded in
+the mean of the eight five-run groups' SSE ranges (about 9 minutes on 2 cores). The result is recorded in
 docs/investigations.md.
 
     python examples/trial_initial_pressure.py [--fresh]
