@@ -735,6 +735,23 @@ def test_calibrate_install_is_checked_before_the_fit(tmp_path, capsys, monkeypat
     assert list(tmp_path.iterdir()) == []
 
 
+def test_calibrate_says_it_has_begun_before_its_workers_start(tmp_path, capsys, monkeypatch):
+    """`twin calibrate` printed nothing for about 15 s, while its workers started and compiled (a helper's probe,
+    stop 40). Its first line now comes before the fit: how many evaluations at most, on how many workers."""
+    import viz.calibration_plots
+    from twin.experiments import calibrate
+
+    _calibration_stand_ins(monkeypatch, tmp_path / "as_built.json")
+    said = []
+    monkeypatch.setattr(calibrate, "calibrate", lambda **kwargs: said.append(capsys.readouterr().err) or
+                        type("R", (), {"evaluations": 1, "wall_time": 0.0}))
+    monkeypatch.setattr(calibrate, "planned_evaluations", lambda: 70)
+    monkeypatch.setattr(viz.calibration_plots, "plot_calibration", lambda data, png: png.write_bytes(b"png"))
+    assert main(["calibrate", "--out", str(tmp_path / "c"), "--workers", "2"]) == 0
+    assert said == ["calibrate: 70 evaluations at most, on 2 workers; a line for each once the workers have "
+                    "started\n"]
+
+
 def test_calibrate_installs_whole_or_not_at_all_and_before_its_figure(tmp_path, capsys, monkeypatch):
     """The preset is replaced by a rename: a disk that fills while the new one is written leaves the old
     one whole (and no temporary); the figure comes after the install, and its failure loses neither file."""
@@ -1184,3 +1201,133 @@ def test_a_broken_pipe_in_process_returns_its_code_and_leaves_the_callers_stdout
     assert parser_default == 141
     after = os.fstat(1)
     assert (before.st_dev, before.st_ino) == (after.st_dev, after.st_ino)
+
+
+class _StopInsideDel:
+    """An object whose ``__del__`` sends ``signum`` to this process: the handler's KeyboardInterrupt is raised
+    inside ``__del__``, where Python swallows it ("Exception ignored in ..."), as it does inside a garbage
+    collector's callback."""
+
+    def __init__(self, signum: int):
+        self.signum = signum
+
+    def __del__(self):
+        os.kill(os.getpid(), self.signum)
+
+
+@pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
+def test_a_stop_python_swallowed_during_a_run_still_stops_it_before_its_outputs(tmp_path, capsys, monkeypatch,
+                                                                                 signum):
+    """A Ctrl-C or SIGTERM that landed inside a garbage collector's callback during `twin run` (2 in 8 tries at
+    one moment) was swallowed: the run wrote its outputs and exited 0, the stop lost. Now it is raised again
+    before the outputs go into place: exit 130, nothing written, and the unraisable hook put back."""
+    from twin.sim import report
+
+    plain = report.write_trace
+
+    def write_trace(result, path):
+        _StopInsideDel(signum)  # dropped at once: its stop is swallowed here
+        plain(result, path)
+
+    monkeypatch.setattr(report, "write_trace", write_trace)
+    hook = sys.unraisablehook
+    assert main(["run", "--controller", "ffpva", "--trajectory", "2", "--trace", str(tmp_path / "t.csv")]) == 130
+    err = capsys.readouterr().err
+    assert err.strip().splitlines()[-1] == "twin: interrupted"
+    assert "Exception ignored" not in err
+    assert list(tmp_path.iterdir()) == []  # no output, no temporary
+    assert sys.unraisablehook is hook
+
+
+def test_a_stop_python_swallowed_during_an_experiment_still_stops_it(tmp_path, capsys, monkeypatch):
+    """The same for a what-if: its tables are not put into place and the folder it made goes."""
+    from twin.experiments.whatifs import gear_load
+
+    plain = type(gear_load.EXPERIMENT).run
+
+    def run(self, args, out):
+        outcome = plain(self, args, out)
+        _StopInsideDel(signal.SIGTERM)
+        return outcome
+
+    monkeypatch.setattr(type(gear_load.EXPERIMENT), "run", run)
+    out = tmp_path / "new"
+    assert main(["whatif", "gear-load", "--out", str(out)]) == 130
+    assert capsys.readouterr().err.strip().splitlines()[-1] == "twin: interrupted"
+    assert not out.exists()
+
+
+def test_other_errors_python_swallows_are_still_reported(tmp_path, monkeypatch):
+    """Only a swallowed stop is kept back: any other error inside ``__del__`` goes to the hook that was there
+    before (Python's prints it), and the command goes on."""
+    from twin.sim import report
+
+    class Broken:
+        def __del__(self):
+            raise ValueError("broken finaliser")
+
+    plain = report.write_trace
+
+    def write_trace(result, path):
+        Broken()
+        plain(result, path)
+
+    monkeypatch.setattr(report, "write_trace", write_trace)
+    seen = []
+    monkeypatch.setattr(sys, "unraisablehook", seen.append)
+    assert main(["run", "--controller", "ffpva", "--trajectory", "2", "--trace", str(tmp_path / "t.csv")]) == 0
+    assert [str(u.exc_value) for u in seen] == ["broken finaliser"]
+    assert (tmp_path / "t.csv").stat().st_size > 10_000
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["run", "--payload", "5_0"], "payload must be a non-negative number of grams, got '5_0'"),
+    (["run", "--seed", "\uff13"], "seed must be an integer from 0 to 2^63 - 1, got '\uff13'"),
+    (["sweep", "--payload", "0,6_5", "--out", "x"], "bad value '6_5' for --payload"),
+    (["sweep", "--seed", "0-1_0", "--out", "x"], "bad value '0-1_0' for --seed"),
+    (["sweep", "--payload", "0:1_0:5", "--out", "x"], "bad value '0:1_0:5' for --payload"),
+    (["whatif", "smc-phi", "--phis", "0.1_5", "--out", "x"], "--phis: numbers in m/s separated by commas"),
+    (["whatif", "pva-rate", "--rates", "\u0664", "--out", "x"], "--rates: whole milliseconds separated by commas"),
+])
+def test_numbers_in_pythons_other_spellings_are_refused(tmp_path, capsys, monkeypatch, argv, needle):
+    """Flags took Python's other number spellings: ``5_0`` as 50, full-width and other scripts' digits (a
+    helper's probe, stop 40), where `twin score` refused ``2_5``. Every number flag and list now reads ASCII
+    digits, a point and an exponent only; nothing is written."""
+    monkeypatch.chdir(tmp_path)
+    try:
+        code = main([*argv[:1], *(["--controller", "ffpva", "--trajectory", "2"] if argv[0] == "run" else []),
+                     *argv[1:]])
+    except SystemExit as stopped:  # a flag's own type: argparse's exit
+        code = stopped.code
+    assert code == 2
+    _one_line_error(capsys, needle)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_numbers_written_plainly_still_read():
+    """What the refusal above must not catch: signs, a leading or trailing point, an exponent, spaces round a
+    list item; an int axis still takes 3.0 as 3."""
+    from twin.batch import grid
+
+    assert grid.parse_axis("payload", "+5, .5,5.,1e1") == [5.0, 0.5, 10.0]
+    assert grid.parse_axis("seed", "3.0, 1-2") == [3, 1, 2]
+    assert grid.plain_number("-0") == 0.0 and grid.plain_number(" 7 ", int) == 7
+
+
+@pytest.mark.parametrize("argv, needle", [
+    (["study", "robustness", "--plant", "", "--out", "x"], "unknown plant ''"),
+    (["study", "openloop", "--plant", "", "--out", "x"], "unknown plant ''"),
+    (["sweep", "--payload", "0,1e400", "--out", "x"], "bad value '1e400' for --payload: expected finite numbers"),
+    (["run", "--controller", "smc", "--trajectory", "2", "--html", "x.html", "--compare", "controller=smc"],
+     "--compare controller=smc: the first joint has these settings already: nothing to compare"),
+    (["run", "--plant", "as-built", "--without", "stiction", "--controller", "smc", "--trajectory", "2", "--html",
+      "x.html", "--compare", "without=stiction,seed=0"], "--compare without=stiction,seed=0: the first joint has"),
+])
+def test_the_probes_last_inputs_are_refused(tmp_path, capsys, monkeypatch, argv, needle):
+    """What a helper's probe (stop 40) left: an empty `--plant` ran the default plant's study; a payload of
+    1e400 was named "inf g"; a `--compare` that changes nothing recorded two alike joints. Each is now a
+    one-line error, exit 2, nothing written."""
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    _one_line_error(capsys, needle)
+    assert list(tmp_path.iterdir()) == []

@@ -134,6 +134,7 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     (lambda rows: [{**rows[0], "rmse_mean_deg": "nan"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from 0.24 to 180"),
     (lambda rows: [{**rows[0], "rmse_mean_deg": "1e-320"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from"),
     (lambda rows: [{**rows[0], "rmse_mean_deg": "1_3"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from"),
+    (lambda rows: [{**rows[0], "rmse_mean_deg": "\uff12.5"}, *rows[1:]], "line 2: rmse_mean_deg must be a number from"),
     # Degrees: a mean below the Hall sensor's noise is most likely radians, one over half a turn no RMSE.
     (lambda rows: [{**r, "rmse_mean_deg": math.radians(float(r["rmse_mean_deg"]) * 2)} for r in rows],
      "radians would be about 57 times smaller"),

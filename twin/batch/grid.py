@@ -13,6 +13,7 @@ from __future__ import annotations
 import dataclasses
 import itertools
 import math
+import re
 import tomllib
 from collections.abc import Iterable
 
@@ -28,6 +29,19 @@ MAX_POINTS = 100_000  # scenarios in one sweep (about 3 days of 4 s runs on 2 co
 NUMERIC = {"payload": float, "supply_kpa": float, "pwm_period_ms": float, "trajectory": int, "seed": int}
 
 
+PLAIN_NUMBER = re.compile(r"\s*[+-]?(?:(?:\d+\.?\d*|\.\d+)(?:e[+-]?\d+)?|inf(?:inity)?|nan)\s*",
+                          re.ASCII | re.IGNORECASE)
+
+
+def plain_number(text: str, kind: type = float) -> int | float:
+    """``kind(text)`` (int or float) for a number written as people write one: ASCII digits, a point, an
+    exponent (and inf or nan, for the caller's range check to name). ValueError for Python's other
+    spellings, which a user hardly means: ``5_0`` (50), full-width or other scripts' digits."""
+    if not PLAIN_NUMBER.fullmatch(text):
+        raise ValueError(f"not a plainly written number: {text!r}")
+    return kind(text)
+
+
 def _whole(value: float) -> int:
     if not value.is_integer():
         raise ValueError(f"{value!r} is not a whole number")
@@ -38,17 +52,20 @@ def _number(text: str, kind: type) -> int | float:
     """``kind`` from ``text``; an int axis takes ``"3"`` or ``"3.0"`` but refuses ``"2.7"`` (never truncates)."""
     if kind is int:
         try:
-            return int(text)
+            return plain_number(text, int)
         except ValueError:
-            return _whole(float(text))
-    return float(text) + 0.0  # + 0.0 turns -0.0 into 0.0: one value, one key
+            return _whole(plain_number(text))
+    value = plain_number(text)
+    if not math.isfinite(value):  # 1e400 too: named as written, not as the inf it became
+        raise ValueError(f"not a finite number: {text!r}")
+    return value + 0.0  # + 0.0 turns -0.0 into 0.0: one value, one key
 
 
 def _range(text: str, kind: type, flag: str) -> list:
     parts = text.split(":")
     if len(parts) != 3:
         raise InvalidScenario(f"bad range {text!r} for {flag}: a range is start:stop:step")
-    start, stop, step = (float(p) for p in parts)
+    start, stop, step = (plain_number(p) for p in parts)
     if not all(math.isfinite(x) for x in (start, stop, step)):
         raise InvalidScenario(f"bad range {text!r} for {flag}: start, stop and step must be finite")
     if step <= 0:
@@ -79,7 +96,7 @@ def parse_axis(name: str, value) -> list:
             if kind is not str and ":" in text:
                 out.update(dict.fromkeys(_range(text, kind, flag)))
             elif name == "seed" and "-" in text.lstrip("-"):
-                low, high = (int(x) for x in text.split("-"))
+                low, high = (plain_number(x, int) for x in text.split("-"))
                 if high < low:
                     raise InvalidScenario(f"bad range {text!r} for {flag}: stop before start")
                 if high - low + 1 > MAX_POINTS:
@@ -93,7 +110,7 @@ def parse_axis(name: str, value) -> list:
         except InvalidScenario:
             raise
         except ValueError:
-            expected = {int: ": expected whole numbers", float: ": expected numbers"}.get(kind, "")
+            expected = {int: ": expected whole numbers", float: ": expected finite numbers"}.get(kind, "")
             raise InvalidScenario(f"bad value {text!r} for --{name.replace('_', '-')}{expected}") from None
     if not out:
         raise InvalidScenario(f"--{name.replace('_', '-')} is empty")

@@ -7,6 +7,7 @@ import os
 import pathlib
 import sys
 
+from twin.batch.tables import counted
 from twin.cli.common import output_folder
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
@@ -28,6 +29,9 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
 
     with output_folder(args.out) as folder:
+        print(f"calibrate: {counted(calibrate.planned_evaluations(), 'evaluation')} at most, on "
+              f"{counted(args.workers, 'worker')}; a line for each once the workers have started",
+              file=sys.stderr, flush=True)  # the first line comes some seconds later: say it has begun
         result = calibrate.calibrate(workers=args.workers, progress=progress)
         data = calibrate.record(result)
         path = calibrate.write(data, args.out)

@@ -15,6 +15,7 @@ import threading
 from twin.batch.lock import folder_lock
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
+from twin.experiments.base import raise_if_stopped, swallowed_stops_kept
 from twin.physics.model import Orientation
 from twin.plants import PLANTS, Plant
 from twin.plants.as_built import EFFECTS, as_built_plant
@@ -111,6 +112,10 @@ def compare_of(args: argparse.Namespace, settings: dict[str, str]):
     except InvalidScenario as error:
         raise InvalidScenario(f"--compare {','.join(f'{k}={v}' for k, v in settings.items())}: {error}") from None
     changes = {COMPARE_FIELDS[key]: getattr(scenario, COMPARE_FIELDS[key]) for key in settings}
+    first = scenario_from(args)
+    if all(getattr(first, field) == value for field, value in changes.items()):
+        raise InvalidScenario(f"--compare {','.join(f'{k}={v}' for k, v in settings.items())}: the first joint "
+                              "has these settings already: nothing to compare")
     return Compare(changes=changes, text=dict(settings))
 
 
@@ -148,15 +153,17 @@ STOPPED_AS_CTRL_C = (signal.SIGTERM, signal.SIGHUP)  # besides Ctrl-C itself
 def sigterm_as_interrupt():
     """SIGTERM (``kill``, a job scheduler) and SIGHUP (the terminal or ssh session closed) stop the ``with``
     block as Ctrl-C does, so the same clean-up runs; the previous handlers afterwards. A signal the process
-    was started ignoring (``nohup`` ignores SIGHUP) stays ignored. Only the main thread may set handlers:
-    elsewhere a no-op."""
+    was started ignoring (``nohup`` ignores SIGHUP) stays ignored. A stop that Python swallowed (it came
+    inside a garbage collector's callback) is raised again before any output goes into place
+    (:func:`swallowed_stops_kept`). Only the main thread may set handlers: elsewhere a no-op."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     previous = {signum: signal.signal(signum, signal.default_int_handler) for signum in STOPPED_AS_CTRL_C
                 if signal.getsignal(signum) is not signal.SIG_IGN}  # ignored (``nohup``): left ignored
     try:
-        yield
+        with swallowed_stops_kept():
+            yield
     finally:
         for signum, handler in previous.items():
             if handler is not None:  # None: a handler set outside Python, which cannot be put back from here
@@ -208,6 +215,7 @@ def all_or_nothing(paths: list[pathlib.Path]):
     temporary = [path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}") for path in paths]
     try:
         yield temporary
+        raise_if_stopped()
         for tmp, path in zip(temporary, paths, strict=True):
             os.replace(tmp, path)
     except OSError as error:  # name the file the user asked for, not its temporary

@@ -10,6 +10,7 @@ import os
 import pathlib
 import tempfile
 
+from twin.batch.grid import plain_number
 from twin.sim.scenario import MAX_SEED
 
 MAX_SEEDS = 1000  # noise seeds per case a command takes (a what-if's cells times 1000 is already a day's work)
@@ -49,8 +50,8 @@ def checked(kind: type, accept, requirement: str):
     """An argparse type: parse with ``kind``, keep it if ``accept(value)``, else name the bad text."""
     def parse(text: str):
         try:
-            value = kind(text)
-        except ValueError:  # not a number; or an integer of over 4300 digits
+            value = plain_number(text, kind)
+        except ValueError:  # not a number (``5_0`` neither); or an integer of over 4300 digits
             value = None
         # An int is always finite, and too long a one would overflow math.isfinite's float.
         if value is None or (isinstance(value, float) and not math.isfinite(value)) or not accept(value):

@@ -130,6 +130,7 @@ def staged(out: pathlib.Path, prefix: str):
     stage = Staging(pathlib.Path(tempfile.mkdtemp(prefix=f".{prefix}-", dir=out)))
     try:
         yield stage
+        raise_if_stopped()
         refuse_folders_in_the_way(out, stage.names)  # before any file of the set moves
     except BaseException:
         shutil.rmtree(stage.folder, ignore_errors=True)
@@ -152,6 +153,37 @@ def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:
 
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+_swallowed_stops: list[KeyboardInterrupt] = []  # kept by swallowed_stops_kept(), raised by raise_if_stopped()
+
+
+@contextlib.contextmanager
+def swallowed_stops_kept():
+    """For the block: a Ctrl-C (or a stop signal taken as one) that Python swallowed, because it came while a
+    garbage collector's callback or a ``__del__`` ran ("Exception ignored in ..."), is kept instead of
+    printed, and :func:`raise_if_stopped` raises it again before any output goes into place, so the stop
+    is not lost. The previous hook afterwards, and every other unraisable error still goes to it."""
+    previous = sys.unraisablehook
+
+    def keep(unraisable) -> None:
+        if isinstance(unraisable.exc_value, KeyboardInterrupt):
+            _swallowed_stops.append(unraisable.exc_value)
+        else:
+            previous(unraisable)
+
+    sys.unraisablehook = keep
+    try:
+        yield
+    finally:
+        sys.unraisablehook = previous
+        _swallowed_stops.clear()
+
+
+def raise_if_stopped() -> None:
+    """KeyboardInterrupt if a stop was swallowed since the last call (:func:`swallowed_stops_kept`): called
+    where a command puts its outputs into place."""
+    if _swallowed_stops:
+        _swallowed_stops.clear()
+        raise KeyboardInterrupt
 
 
 @contextlib.contextmanager

@@ -57,6 +57,7 @@ from collections.abc import Callable, Sequence
 import numpy as np
 
 from twin.batch.sweep import code_version, fork_pool, kill_pool
+from twin.experiments.base import raise_if_stopped
 from twin.experiments.reference import (
     THESIS_EXPERIMENT_RMSE_DEG,
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
@@ -364,6 +365,16 @@ class _BudgetSpent(Exception):
     """The simplex has used its evaluations."""
 
 
+def planned_evaluations(*, scan_points: int = SCAN_POINTS, simplex_evaluations: int = SIMPLEX_EVALUATIONS,
+                        profile_points: int = PROFILE_POINTS,
+                        noise_seed_sets: Sequence[Sequence[int]] = NOISE_SEED_SETS,
+                        previous: Sequence[dict[str, float]] | None = None) -> int:
+    """The most evaluations :func:`calibrate` makes with these settings (the simplex may stop sooner)."""
+    previous = previous_fits() if previous is None else previous
+    return (scan_points + 1 + simplex_evaluations + profile_points * len(PROFILED) + len(noise_seed_sets)
+            + len(previous))
+
+
 def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_seeds: Sequence[int] = CHECK_SEEDS,
               noise_seed_sets: Sequence[Sequence[int]] = NOISE_SEED_SETS, scan_points: int = SCAN_POINTS,
               simplex_evaluations: int = SIMPLEX_EVALUATIONS, profile_points: int = PROFILE_POINTS,
@@ -384,8 +395,9 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
     from scipy.stats import qmc
 
     started = time.perf_counter()
-    planned = (scan_points + 1 + simplex_evaluations + profile_points * len(PROFILED) + len(noise_seed_sets)
-               + len(previous))
+    planned = planned_evaluations(scan_points=scan_points, simplex_evaluations=simplex_evaluations,
+                                  profile_points=profile_points, noise_seed_sets=noise_seed_sets,
+                                  previous=previous)
     history: list[Evaluation] = []
     seen: dict[tuple[float, ...], tuple[Evaluation, list[CellResult]]] = {}
     evaluator = Evaluator(seeds=fit_seeds, workers=workers)
@@ -523,6 +535,7 @@ def write(data: dict, out: pathlib.Path, name: str = "as_built.json") -> pathlib
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     try:
         tmp.write_text(json.dumps(data, indent=1) + "\n")
+        raise_if_stopped()
         tmp.replace(path)
     finally:
         tmp.unlink(missing_ok=True)

@@ -50,6 +50,7 @@ import pathlib
 
 import numpy as np
 
+from twin.batch.grid import plain_number
 from twin.batch.tables import write_csv
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome, drawn
@@ -166,7 +167,7 @@ def _number(text: str, where: str, column: str, *, low: float = 0.0, high: float
             hint: str = "") -> float:
     """``text`` as a finite number from ``low`` to ``high``, else a one-line error (ending in ``hint``)."""
     try:
-        value = float(text) if "_" not in text else math.nan
+        value = plain_number(text)
     except ValueError:
         value = math.nan
     if not math.isfinite(value) or not low <= value <= high:

@@ -223,7 +223,7 @@ class OpenLoopExperiment(Experiment):
         parser.add_argument("--plant", default=None, metavar="NAME", help="default: as-built if present, else thesis-pwm")
 
     def check(self, args: argparse.Namespace) -> None:
-        args.plant = args.plant or default_plant("thesis-pwm")
+        args.plant = default_plant("thesis-pwm") if args.plant is None else args.plant
         plant(args.plant)
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:

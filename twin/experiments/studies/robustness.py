@@ -266,7 +266,7 @@ class RobustnessStudyExperiment(Experiment):
                             help="as-built: skip the calibration ensemble's runs (no band in the summary)")
 
     def check(self, args: argparse.Namespace) -> None:
-        args.plant = args.plant or default_plant("thesis")
+        args.plant = default_plant("thesis") if args.plant is None else args.plant
         plant(args.plant)  # an unknown name is a one-line error before anything is written
         args.ensemble = args.ensemble and args.plant == "as-built"
         args.points = robustness_grid(plant_name=args.plant, seeds=args.seeds, ensemble=args.ensemble)  # too big too

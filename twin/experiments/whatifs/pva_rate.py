@@ -19,6 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 
 import twin.experiments.whatifs.ensemble as ensemble
+from twin.batch.grid import plain_number
 from twin.batch.tables import counted, signed
 from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
@@ -34,7 +35,7 @@ DEFAULT_RATES_MS = (1, 2, 4, 8, 16)
 
 def parse_rates(text: str) -> tuple[int, ...]:
     """``--rates``: whole milliseconds from 1 to 64, comma-separated; 16 (the thesis's) is always run."""
-    rates = number_list(text, "--rates", "whole milliseconds", int)
+    rates = number_list(text, "--rates", "whole milliseconds", lambda part: plain_number(part, int))
     if not rates or not all(1 <= r <= 64 for r in rates):
         raise InvalidScenario(f"--rates: each update period must be 1-64 ms, got {text!r}")
     if rates == [THESIS_UPDATE_MS]:
