@@ -1,10 +1,11 @@
 """A run as one self-contained HTML file: the 3D animation beside strip charts
 of the run's traces (angle and desired, error, duty, pressures, valves), with
 the page's own play / pause / scrub / speed controls driving one clock that
-poses the 3D view and moves the charts' cursor together. In compare mode both
-joints are drawn and their traces overlaid. Works offline: meshcat's viewer
-script, the chart drawer (``viz/strip_chart.js``), the scene, the animation and
-the traces are all inside the file.
+poses the 3D view and moves the charts' cursor together; a drag across a chart
+zooms every chart to that span. In compare mode both joints are drawn and their
+traces overlaid. Works offline: meshcat's viewer script, the chart drawer
+(``viz/strip_chart.js``), the scene, the animation and the traces are all inside
+the file.
 """
 
 from __future__ import annotations

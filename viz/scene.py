@@ -12,16 +12,18 @@ what the MJCF has no geometry for:
 * the four valves V1-V4 (§4) as lamps, lit when open;
 * a ghost of the link at the desired angle (the link's pose with the racks
   placed at the reference, through MuJoCo's kinematics);
-* an arrow along gravity.
+* an arrow along gravity, beside the cylinders' closed ends, out of the link's
+  reach.
 
 The joint is millimetres across and meshcat's camera orbits the world origin,
 so everything hangs under ``/twin`` (compare mode's second joint under
 ``/compare``, tinted, beside the first), drawn ``SCALE`` times larger with the
 middle of the mechanism at the origin, and meshcat's metre grid and axes are
 hidden. Each joint carries an invisible box, ``<root>/bodies/housing/view_box``,
-round its cylinders, racks, gears and the link's whole sweep: the pages fit the
-camera to those boxes (:func:`scene_commands` sets the direction: from above
-and in front). Gears are flat-shaded solids, the housing translucent so the
+round its cylinders, racks, gears, gravity arrow and the link's whole sweep: the
+pages fit the camera to those boxes (:func:`scene_commands` sets the direction,
+by orientation: from in front and 45 deg above a joint lying flat, 10 deg above
+one on its side). Gears are flat-shaded solids, the housing translucent so the
 pinion shows through it, the payload a brass sphere of its true size.
 Commands are meshcat's lowered dicts: :mod:`viz.recording` packs them into
 an HTML file, :mod:`viz.live_server` streams them to a browser.
@@ -60,11 +62,22 @@ CHAMBERS = {"a": ("cylinder_a_barrel", "rack_a_rod"), "b": ("cylinder_b_barrel",
 GHOST_RGBA = (0.9, 0.9, 0.95, 0.35)
 GHOST_LIFT = 1.2e-3  # m along the shaft
 GRAVITY_ARROW_LENGTH = 12e-3  # m
-GRAVITY_ARROW_BASE = np.array([0.03, 0.02, 0.0])  # m, in the world, beside the joint
-# Camera direction in the world (z up), toward the camera: from above and in front (horizontal, the
-# link turns in the x-y plane) or from in front and a little above (vertical, the x-z plane). Its
-# distance is fitted to the view boxes by the page; CAMERA_DISTANCE is the start before the fit.
-CAMERA_DIRECTION = {"horizontal": (0.0, -0.57, 0.82), "vertical": (0.0, -0.9, 0.42)}
+GRAVITY_ARROW_HEAD_RADIUS = 1.2e-3  # m
+# The arrow's middle, in the housing frame, by orientation: beside the cylinders' closed ends, where the link
+# never reaches (its sweep stays within about 37 mm of the spur, at x = 6.6 mm), on the housing's side toward
+# the camera (-y: in front of a joint lying flat) or against gravity (+y: above a joint on its side, clear of
+# the 3D view's legend at the bottom left): no part of the joint comes between it and the camera. It stood in
+# the sweep, and the link passed over it (in compare mode, seen from further above, it hid behind the link).
+GRAVITY_ARROW_MIDDLE = {"horizontal": np.array([-0.048, -0.02, 0.0]), "vertical": np.array([-0.048, 0.02, 0.0])}  # m
+# Camera direction in the world (z up), toward the camera, each showing how the joint stands. Horizontal (the
+# link turns in the x-y plane, gravity across it): from in front and 45 deg above, as a joint lying on a bench
+# is seen, its sweep drawn as a flattened disc and the gravity arrow upright on the screen. Vertical (the x-z
+# plane, gravity in it): from in front and 10 deg above, the sweep nearly face-on and up the screen's up. (Both
+# were about 30 deg off face-on, and drew the same picture.) The distance is fitted to the view boxes by the
+# page; CAMERA_DISTANCE is the start before the fit.
+CAMERA_ELEVATION_DEG = {"horizontal": 45.0, "vertical": 10.0}
+CAMERA_DIRECTION = {name: (0.0, -float(np.cos(np.radians(deg))), float(np.sin(np.radians(deg))))
+                    for name, deg in CAMERA_ELEVATION_DEG.items()}
 CAMERA_DISTANCE = 1.4  # m, in the drawn (SCALE times) scene
 VIEW_MARGIN = 1.5e-3  # m round the view box
 COMPARE_ROOT = "compare"
@@ -141,7 +154,7 @@ class JointScene:
     # -- the scene, sent once ------------------------------------------------
     def view_box(self) -> tuple[np.ndarray, np.ndarray]:
         """Corners (m, housing frame) of the box the camera keeps in view: the cylinders and valves,
-        the racks and gears, and the link with its payload over the racks' whole travel."""
+        the racks and gears, the link with its payload over the racks' whole travel, and the gravity arrow."""
         m, data = self.model, self.kinematics
         low, high = np.full(3, np.inf), np.full(3, -np.inf)
         for name in ("cylinder_a_barrel", "cylinder_b_barrel"):
@@ -152,7 +165,7 @@ class JointScene:
             low, high = np.minimum(low, [x - VALVE_RADIUS, y - VALVE_RADIUS, z]), np.maximum(high, [x, y, z])
         payload = m.geom("payload_mass").id
         reach_out = float(m.geom_size[payload][0]) if self._rgba(payload)[3] > 0 else 0.0
-        housing = data.xmat[self.housing_body].reshape(3, 3), data.xpos[self.housing_body].copy()
+        housing = self._housing_pose()
         travel = m.jnt_range[m.body_jntadr[m.body("rack_a").id]]
         for y in np.linspace(travel[0], travel[1], 49):  # the link's sweep, through MuJoCo's kinematics
             self._place(data, float(y))
@@ -161,6 +174,9 @@ class JointScene:
             low, high = np.minimum(low, tip - reach_out), np.maximum(high, tip + reach_out)
         shell = m.geom("housing_shell").id
         low[2] = min(low[2], -m.geom_size[shell][2])
+        for end in self._gravity_arrow_ends():
+            reach = GRAVITY_ARROW_HEAD_RADIUS
+            low, high = np.minimum(low, end - reach), np.maximum(high, end + reach)
         return low - VIEW_MARGIN, high + VIEW_MARGIN
 
     def setup_commands(self) -> list[dict]:
@@ -249,6 +265,20 @@ class JointScene:
             return g.Cylinder(2 * float(size[1]), float(size[0])), _homogeneous(rotation @ _Y_TO_Z, position)
         raise ValueError(f"geom {name!r}: no meshcat shape for MuJoCo geom type {kind}")
 
+    def _housing_pose(self) -> tuple[np.ndarray, np.ndarray]:
+        """The housing's rotation and origin in the world (it is fixed: a joint on its side is turned by it)."""
+        data = self.kinematics
+        return data.xmat[self.housing_body].reshape(3, 3).copy(), data.xpos[self.housing_body].copy()
+
+    def _gravity_arrow_ends(self) -> tuple[np.ndarray, np.ndarray]:
+        """The gravity arrow's tail and tip (m, housing frame): GRAVITY_ARROW_LENGTH along gravity, about
+        GRAVITY_ARROW_MIDDLE."""
+        gravity = self.model.opt.gravity
+        rotation, _ = self._housing_pose()
+        down = rotation.T @ (gravity / np.linalg.norm(gravity))
+        middle, half = GRAVITY_ARROW_MIDDLE[self.joint.orientation.value], down * GRAVITY_ARROW_LENGTH / 2
+        return middle - half, middle + half
+
     def _gravity_arrow(self) -> list[dict]:
         gravity = self.model.opt.gravity
         down = gravity / np.linalg.norm(gravity)
@@ -259,12 +289,13 @@ class JointScene:
         x /= np.linalg.norm(x)
         rotation = np.column_stack([x, up, np.cross(x, up)])
         shaft, head = 0.7 * GRAVITY_ARROW_LENGTH, 0.3 * GRAVITY_ARROW_LENGTH
-        base = GRAVITY_ARROW_BASE
+        housing, origin = self._housing_pose()
+        base = housing @ self._gravity_arrow_ends()[0] + origin  # the tail, in the world
         grey = _material((0.3, 0.3, 0.3, 1.0))
         return [
             SetObject(g.Cylinder(shaft, 0.4e-3), grey, Path((self.root, "gravity", "shaft"))).lower(),
             SetTransform(_homogeneous(rotation, base - up * shaft / 2), Path((self.root, "gravity", "shaft"))).lower(),
-            SetObject(g.Cylinder(head, radiusTop=1.2e-3, radiusBottom=0.0), grey,
+            SetObject(g.Cylinder(head, radiusTop=GRAVITY_ARROW_HEAD_RADIUS, radiusBottom=0.0), grey,
                       Path((self.root, "gravity", "head"))).lower(),
             SetTransform(_homogeneous(rotation, base - up * (shaft + head / 2)),
                          Path((self.root, "gravity", "head"))).lower(),
@@ -344,8 +375,8 @@ def placement(scenes: Sequence[JointScene]) -> list[np.ndarray]:
 
 
 def scene_commands(scenes: Sequence[JointScene]) -> list[dict]:
-    """The whole scene: meshcat's grid and axes hidden, the camera's direction (from above and in
-    front of the first joint's plane of rotation), each joint placed (:func:`placement`) and drawn."""
+    """The whole scene: meshcat's grid and axes hidden, the camera's direction (CAMERA_DIRECTION, by the
+    first joint's orientation), each joint placed (:func:`placement`) and drawn."""
     commands = [SetProperty("visible", False, Path(("Grid",))).lower(),
                 SetProperty("visible", False, Path(("Axes",))).lower()]
     x, y, z = CAMERA_DISTANCE * np.array(CAMERA_DIRECTION[scenes[0].joint.orientation.value])

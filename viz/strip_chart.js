@@ -6,9 +6,12 @@
 //   {time: [s], angle_deg, desired_deg, error_deg, duty (%), pressure_a_kpa, pressure_b_kpa,
 //    supply_kpa, valves: [[time, [V1, V2, V3, V4]], ...] (each change)}
 // Every chart draws every trace over the same time window [t0, t1]: the first joint in solid lines,
-// compare mode's second joint dashed and in a tint, with a legend.
+// compare mode's second joint dashed and in a tint, with a legend. A series that the second joint draws otherwise
+// says how (``compare``: its legend name, colour and dash): its chambers A and B, in one tint, looked alike.
 "use strict";
 
+const TWIN_COMPARE_TINT = "#12a5b0";  // teal, as the second joint in the 3D view (viz/scene.py COMPARE_TINT)
+const TWIN_COMPARE_DARK = "#0b6b73";  // a darker teal: the second joint's chamber B, beside its chamber A in teal
 const TWIN_CHARTS = [
   {id: "angle", title: "angle", unit: "deg", series: [
     {key: "angle_deg", label: "angle", color: "#c0392b"},
@@ -18,12 +21,18 @@ const TWIN_CHARTS = [
   {id: "duty", title: "duty", unit: "%", symmetric: true, minSpan: 20, series: [
     {key: "duty", label: "duty", color: "#2471a3"}]},
   {id: "pressure", title: "pressure", unit: "kPa", fromZero: true, series: [
-    {key: "pressure_a_kpa", label: "chamber A", color: "#d35400"},
-    {key: "pressure_b_kpa", label: "chamber B", color: "#1e8449"},
+    {key: "pressure_a_kpa", label: "chamber A", color: "#d35400", compare: {label: "A"}},
+    {key: "pressure_b_kpa", label: "chamber B", color: "#1e8449",
+     compare: {label: "B", color: TWIN_COMPARE_DARK, dash: [8, 2, 2, 2]}},
     {key: "supply_kpa", label: "supply", color: "#555555", dash: [1, 3]}]},
   {id: "valves", title: "valves (open)", unit: "", kind: "valves"},
 ];
-const TWIN_COMPARE_TINT = "#12a5b0";  // teal, as the second joint in the 3D view (viz/scene.py COMPARE_TINT)
+
+// How the second joint draws series ``s``: teal, dashed (dotted where the first joint's is), unless it says otherwise.
+function twinCompareStyle(s) {
+  const own = s.compare || {};
+  return {color: own.color || TWIN_COMPARE_TINT, dash: own.dash || (s.dash ? [1, 3] : [5, 3])};
+}
 
 // A number with ``digits`` decimals, never "-0" (a small negative duty or pressure reads 0): both pages' readouts.
 function twinFixed(x, digits) {
@@ -44,9 +53,10 @@ class StripCharts {
       canvas.dataset.chart = spec.id;
       box.appendChild(canvas);
       container.appendChild(box);
-      return {spec, canvas, layout: null};
+      return {spec, canvas, layout: null, legend: []};
     });
     this.draws = 0;
+    this.selection = null;  // [t0, t1] s swept by a drag under way (enableZoom), drawn as a band
   }
 
   // Draw ``traces`` (one per joint) over [t0, t1] s, with a cursor at ``cursor`` s (or none).
@@ -60,6 +70,49 @@ class StripCharts {
     const chart = this.charts.find((c) => c.spec.id === id);
     const L = chart.layout;
     return L.left + (t - L.t0) / Math.max(L.t1 - L.t0, 1e-9) * L.width;
+  }
+
+  // The time (s) at CSS x pixels from a chart's left edge, within the time shown.
+  timeAt(id, x) {
+    const L = this.charts.find((c) => c.spec.id === id).layout;
+    return L.t0 + Math.min(Math.max((x - L.left) / L.width, 0), 1) * (L.t1 - L.t0);
+  }
+
+  // Let the charts be zoomed (a recording's): a drag across any chart asks for the time span it swept, drawn as a
+  // band meanwhile; a double-click asks for the whole run. ``zoom(span)`` gets [t0, t1] s, or null for the whole
+  // run, and draws; ``redraw()`` draws as they are (the band moved).
+  enableZoom(zoom, redraw) {
+    for (const chart of this.charts) {
+      const canvas = chart.canvas, id = chart.spec.id;
+      canvas.style.cursor = "crosshair";
+      canvas.style.touchAction = "none";  // a finger's drag zooms too, not scrolls the panel
+      canvas.title = "drag across to zoom every chart; double-click for the whole run";
+      let start = null;  // the drag's first x (CSS px from the canvas's left) and time
+      const x = (e) => e.clientX - canvas.getBoundingClientRect().left;
+      const swept = (e) => {
+        const t = this.timeAt(id, x(e));
+        return [Math.min(start.t, t), Math.max(start.t, t)];
+      };
+      canvas.addEventListener("pointerdown", (e) => {
+        if (e.button !== 0 || !chart.layout) return;
+        start = {x: x(e), t: this.timeAt(id, x(e))};
+        canvas.setPointerCapture(e.pointerId);
+      });
+      canvas.addEventListener("pointermove", (e) => {
+        if (start === null) return;
+        this.selection = swept(e);
+        redraw();
+      });
+      canvas.addEventListener("pointerup", (e) => {
+        if (start === null) return;
+        const span = swept(e), dragged = Math.abs(x(e) - start.x) >= 4;  // a click (or a double-click's) is no zoom
+        start = null;
+        this.selection = null;
+        if (dragged) zoom(span); else redraw();
+      });
+      canvas.addEventListener("pointercancel", () => { start = null; this.selection = null; redraw(); });
+      canvas.addEventListener("dblclick", () => zoom(null));
+    }
   }
 
   _size(canvas) {
@@ -138,16 +191,21 @@ class StripCharts {
     ctx.lineWidth = 1;
     ctx.textAlign = "center";
     ctx.textBaseline = "top";
-    for (const t of this._ticks(t0, t1, Math.max(2, Math.floor(width / 60)))) {
+    const times = this._ticks(t0, t1, Math.max(2, Math.floor(width / 60)));
+    // as many decimals as the step needs (0.5 s: one; a zoomed 0.05 s: two), and one under a 4 s window
+    const step = times.length > 1 ? times[1] - times[0] : 1;
+    const digits = Math.max(Math.abs(t1 - t0) < 4 ? 1 : 0, Math.ceil(-Math.log10(step) - 1e-9));
+    for (const t of times) {
       const x = xOf(t);
       ctx.beginPath(); ctx.moveTo(x, top); ctx.lineTo(x, top + height); ctx.stroke();
       ctx.fillStyle = "#444";
-      ctx.fillText(t.toFixed(Math.abs(t1 - t0) < 4 ? 1 : 0) + (x > left + width - 30 ? " s" : ""), x, top + height + 2);
+      ctx.fillText(t.toFixed(digits) + (x > left + width - 30 ? " s" : ""), x, top + height + 2);
     }
     if (spec.kind === "valves") {
-      this._drawValves(ctx, traces, t0, t1, xOf, left, top, width, height);
+      chart.legend = this._drawValves(ctx, traces, t0, t1, xOf, left, top, width, height);
     } else {
       const [lo, hi] = this._range(spec, traces, t0, t1);
+      Object.assign(chart.layout, {lo, hi});  // the value span shown, bottom to top
       const yOf = (v) => top + height - (v - lo) / (hi - lo) * height;
       ctx.textAlign = "right";
       ctx.textBaseline = "middle";
@@ -164,9 +222,10 @@ class StripCharts {
         for (const s of spec.series) {
           const ys = tr[s.key];
           if (!ys) continue;
-          ctx.strokeStyle = j === 0 ? s.color : TWIN_COMPARE_TINT;
+          const style = j === 0 ? {color: s.color, dash: s.dash || []} : twinCompareStyle(s);
+          ctx.strokeStyle = style.color;
           ctx.lineWidth = j === 0 ? 1.4 : 1.6;
-          ctx.setLineDash(j === 0 ? (s.dash || []) : (s.dash ? [1, 3] : [5, 3]));
+          ctx.setLineDash(style.dash);
           ctx.beginPath();
           let started = false;
           const time = tr.time;
@@ -192,12 +251,18 @@ class StripCharts {
       });
       ctx.setLineDash([]);
       ctx.restore();
-      this._legend(ctx, spec, traces.length, left + width, 11, left + ctx.measureText(spec.title + " (" + spec.unit + ")").width + 8);
+      chart.legend = this._legend(ctx, spec, traces.length, left + width, 11,
+                                  left + ctx.measureText(spec.title + " (" + spec.unit + ")").width + 8);
+    }
+    if (this.selection) {  // a drag under way: the span it will zoom to
+      const [a, b] = this.selection.map((t) => Math.min(Math.max(xOf(t), left), left + width));
+      ctx.fillStyle = "rgba(36, 113, 163, 0.18)";
+      ctx.fillRect(a, top, b - a, height);
     }
     ctx.strokeStyle = "#999";
     ctx.lineWidth = 1;
     ctx.strokeRect(left + 0.5, top + 0.5, width - 1, height - 1);
-    if (cursor !== null && cursor !== undefined) {
+    if (cursor !== null && cursor !== undefined && cursor >= t0 && cursor <= t1) {  // none outside a zoomed span
       const x = xOf(cursor);
       ctx.strokeStyle = "rgba(200, 0, 0, 0.85)";
       ctx.lineWidth = 2;
@@ -206,23 +271,36 @@ class StripCharts {
   }
 
   // The legend, right-aligned between ``leftmost`` (the title's end) and ``right``: in a smaller font when
-  // it does not fit, and only then without its last series (the first series, as chamber A, stays; so does
-  // the compare joint's entry, "compare" on both pages: the page's title and info say what it is).
+  // it does not fit, and only then without its last series (the first series, as chamber A, stays; so do
+  // the compare joint's entries: "compare" on both pages, the page's title and info say what it is, or one per
+  // series the second joint draws its own way, "compare A" and "compare B"). Returns the names drawn.
   _legend(ctx, spec, count, right, y, leftmost = 0) {
     ctx.textAlign = "right";
     ctx.textBaseline = "alphabetic";
     let x = right;
     const items = [];
     for (const s of spec.series) items.push([s.label, s.color, s.dash || []]);
-    const kept = count > 1 ? 2 : 1;  // the first series, and the compare entry when there is one
-    if (count > 1) items.push([this.labels[1] || "compare", TWIN_COMPARE_TINT, [5, 3]]);
+    const compares = [];
+    if (count > 1) {
+      const name = this.labels[1] || "compare";
+      for (const s of spec.series) {
+        if (!s.compare || !s.compare.label) continue;
+        const style = twinCompareStyle(s);
+        compares.push([`${name} ${s.compare.label}`, style.color, style.dash]);
+      }
+      if (!compares.length) compares.push([name, TWIN_COMPARE_TINT, [5, 3]]);
+    }
+    items.push(...compares);
+    const kept = 1 + compares.length;  // the first series, and the compare entries when there are any
     const needs = () => items.reduce((w, [label]) => w + ctx.measureText(label).width + 23, 0);
     for (let size = 9; size >= 8 && needs() > right - leftmost; size--) ctx.font = `${size}px sans-serif`;
-    while (items.length > kept && needs() > right - leftmost) items.splice(items.length - kept, 1);
+    while (items.length > kept && needs() > right - leftmost) items.splice(items.length - compares.length - 1, 1);
+    const drawn = [];
     for (const [label, color, dash] of items.reverse()) {
       if (x - ctx.measureText(label).width - 20 < leftmost) break;  // no room even for one: the title stays readable
       ctx.fillStyle = "#333";
       ctx.fillText(label, x, y);
+      drawn.unshift(label);
       x -= ctx.measureText(label).width + 3;
       ctx.strokeStyle = color;
       ctx.lineWidth = 1.6;
@@ -232,6 +310,7 @@ class StripCharts {
       x -= 20;
     }
     ctx.font = "10px sans-serif";
+    return drawn;
   }
 
   _drawValves(ctx, traces, t0, t1, xOf, left, top, width, height) {
@@ -266,7 +345,7 @@ class StripCharts {
     });
     ctx.font = "10px sans-serif";
     const legend = {spec: {series: [{label: "open", color: "#2ca02c"}]}};
-    this._legend(ctx, legend.spec, share, left + width, 11, left + 80);
+    return this._legend(ctx, legend.spec, share, left + width, 11, left + 80);
   }
 }
 

@@ -499,3 +499,186 @@ def test_space_plays_a_recording_after_the_scrub_bar_was_used(tmp_path, page):
     assert page.evaluate("window.twinClock.playing") is True
     page.keyboard.press("Space")
     assert page.evaluate("window.twinClock.playing") is False
+
+
+def sight_to_axis_deg(page, root: str = "twin") -> float:
+    """Angle (deg) between the camera's line of sight and the spur's axis (the normal of the plane the link turns
+    in): 0 sees that plane face-on, 90 edge-on."""
+    return page.evaluate(f"""(() => {{
+        const spur = viewer.scene_tree.find(['{root}', 'bodies', 'spur']).object;
+        spur.updateMatrixWorld(true);
+        const axis = new MeshCat.THREE.Vector3().setFromMatrixColumn(spur.matrixWorld, 2).normalize();
+        const sight = viewer.camera.getWorldDirection(new MeshCat.THREE.Vector3());
+        return Math.acos(Math.min(1, Math.abs(axis.dot(sight)))) * 180 / Math.PI; }})()""")
+
+
+@pytest.mark.slow  # a live twin, rebuilt once, and a page: about 15 s on 2 cores
+def test_each_orientation_is_framed_as_it_stands(page):
+    """A joint lying flat (horizontal) is seen from in front and above, its plane of rotation at a slant; one on its
+    side (vertical) nearly face-on, gravity down the screen. Both were seen about 30 deg off face-on (35 and 26
+    deg), the same picture (a helper in chromium, stop 40). Each fit keeps the mechanism's box in view."""
+    proc, log, url, port = start_twin("--controller", "smc", "--trajectory", "1")
+    try:
+        page.set_viewport_size({"width": 1280, "height": 720})
+        page.goto(url)
+        page.wait_for_function("window.twinLast !== null && window.twinState !== undefined", timeout=60_000)
+        page.wait_for_timeout(500)
+        assert page.evaluate("window.twinState.orientation") == "horizontal"
+        flat = sight_to_axis_deg(page)
+        assert_fills(view_fit(page))
+        page.select_option("#orientation", "vertical")  # rebuilt: the new scene sets the camera, the page fits it
+        page.wait_for_function("window.twinState.orientation === 'vertical'", timeout=30_000)
+        page.wait_for_timeout(800)
+        upright = sight_to_axis_deg(page)
+        assert_fills(view_fit(page))
+        assert flat >= 40.0, flat  # at a slant (the scene's camera: 45 deg above the bench, 45 deg off face-on)
+        assert upright <= 15.0, upright  # nearly face-on (10 deg above the joint's middle)
+        assert_scene_rendered(screenshot(page, "live-vertical-framed.png"), least=100)
+    finally:
+        proc.kill()
+        proc.wait(10)
+        log.close()
+
+
+def record(directory: pathlib.Path, *flags: str) -> pathlib.Path:
+    """An ``--html`` recording of ``twin run`` with ``flags``."""
+    html = directory / "run.html"
+    proc = subprocess.run([sys.executable, "-m", "twin", "run", *flags, "--html", str(html)], cwd=directory,
+                          env=twin_env(), capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    return html
+
+
+def open_recording(page, html: pathlib.Path) -> None:
+    """Open a recording offline and pause it at 0.6 s."""
+    page.route("**/*", lambda route: route.abort() if not route.request.url.startswith("file:") else route.continue_())
+    page.goto(html.as_uri())
+    wait_for_animation(page)
+    page.wait_for_function("window.twinPlots && window.twinPlots.draws > 2", timeout=30_000)
+    if page.evaluate("window.twinClock.playing"):
+        page.click("#play")
+    scrub_to(page, 0.6)
+
+
+def scrub_to(page, t: float) -> None:
+    page.evaluate(f"const s = document.getElementById('scrub'); s.value = {t}; s.dispatchEvent(new Event('input'));")
+    page.wait_for_timeout(200)
+
+
+COMPARE_B_TEAL = (11, 107, 115)  # the compare joint's chamber B (viz/strip_chart.js TWIN_COMPARE_DARK)
+
+
+@pytest.mark.slow  # a compare recording and a page: about 10 s on 2 cores
+def test_the_compare_joints_chambers_are_told_apart(tmp_path, page):
+    """The second joint's chamber A and B pressures were both dashed teal, told apart only by where they ran (a
+    helper in chromium, stop 40): B is now a darker teal, dash-dotted, and the legend names "compare A" and
+    "compare B"; a legend short of room still keeps them and the first series, dropping the first joint's later
+    ones first."""
+    html = record(tmp_path, "--controller", "ffpva", "--trajectory", "1", "--compare", "controller=smc,payload=13.5")
+    open_recording(page, html)
+    assert chart_pixels(page, "pressure", TEAL) > 20  # chamber A
+    assert chart_pixels(page, "pressure", COMPARE_B_TEAL) > 20  # chamber B
+    assert chart_pixels(page, "angle", COMPARE_B_TEAL) < 5  # the darker teal is chamber B's alone
+    legends = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legend])"))
+    assert legends["pressure"] == ["chamber A", "chamber B", "supply", "compare A", "compare B"]
+    assert all(legends[chart][-1] == "compare" for chart in ("angle", "error", "duty", "valves"))
+    page.set_viewport_size({"width": 800, "height": 600})  # a narrow panel: the legend gives up the first's later series
+    page.wait_for_timeout(500)
+    narrow = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legend])"))["pressure"]
+    assert narrow[0] == "chamber A" and narrow[-2:] == ["compare A", "compare B"], narrow
+    assert chart_pixels(page, "pressure", COMPARE_B_TEAL) > 10
+
+
+def chart_rows(page, chart: str, test: str) -> list[float]:
+    """The CSS rows (from the canvas's top) where chart ``chart``'s plot has a pixel whose r, g, b pass ``test``
+    (a JavaScript expression)."""
+    return page.evaluate(f"""(() => {{
+        const chart = window.twinPlots.charts.find((c) => c.spec.id === '{chart}'), L = chart.layout, c = chart.canvas;
+        const ratio = c.width / c.clientWidth, d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        const rows = [];
+        for (let y = Math.ceil(L.top * ratio); y < (L.top + L.height) * ratio; y++)
+            for (let x = Math.ceil(L.left * ratio); x < (L.left + L.width) * ratio; x++) {{
+                const i = 4 * (y * c.width + x), r = d[i], g = d[i + 1], b = d[i + 2];
+                if ({test}) {{ rows.push(y / ratio); break; }}
+            }}
+        return rows; }})()""")
+
+
+def layouts(page) -> dict:
+    return dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.layout])"))
+
+
+@pytest.mark.slow  # a recording and a page: about 10 s on 2 cores
+def test_a_recordings_charts_zoom_to_a_dragged_span_and_back(tmp_path, page):
+    """A recording's charts showed the whole run only (a helper in chromium, stop 40). A drag across any chart
+    zooms every chart to the span it swept, each value axis fitted to that span's samples and each one's peaks
+    drawn; scrubbing and playing go on (the cursor where its time falls in the span, none outside it); a
+    double-click, or the "whole run" button, shows the whole run again."""
+    html = record(tmp_path, "--controller", "ffpva", "--trajectory", "1")
+    open_recording(page, html)
+    duration = page.evaluate("window.twinTrace.time[window.twinTrace.time.length - 1]")
+    assert all(L["t0"] == 0 and L["t1"] == pytest.approx(duration) for L in layouts(page).values())
+    assert page.is_disabled("#whole-run")
+    box = page.locator('canvas[data-chart="error"]').bounding_box()
+    x_at = lambda t: box["x"] + page.evaluate(f"window.twinPlots.xOf('error', {t})")  # noqa: E731
+    y = box["y"] + box["height"] / 2
+    page.mouse.move(x_at(0.3), y)
+    page.mouse.down()
+    page.mouse.move(x_at(0.9), y, steps=6)
+    page.mouse.up()
+    page.wait_for_timeout(200)
+    seconds_per_px = duration / layouts(page)["error"]["width"]
+    for chart, L in layouts(page).items():
+        assert L["t0"] == pytest.approx(0.3, abs=2 * seconds_per_px), chart
+        assert L["t1"] == pytest.approx(0.9, abs=2 * seconds_per_px), chart
+    assert page.is_enabled("#whole-run")
+    assert page.evaluate("window.twinClock.time") == pytest.approx(0.6) and not page.evaluate("window.twinClock.playing")
+
+    # the value axes fit the span's samples, and the error's highest and lowest in the span are drawn
+    L = layouts(page)
+    trace = page.evaluate("window.twinTrace")
+    inside = [i for i, t in enumerate(trace["time"]) if L["angle"]["t0"] <= t <= L["angle"]["t1"]]
+    angles = [trace[key][i] for key in ("angle_deg", "desired_deg") for i in inside]
+    low, high = min(angles), max(angles)
+    pad = 0.06 * (high - low)
+    assert (L["angle"]["lo"], L["angle"]["hi"]) == (pytest.approx(low - pad), pytest.approx(high + pad))
+    assert high - low < 0.9 * (max(trace["angle_deg"]) - min(trace["angle_deg"]))  # not the whole run's range
+    errors = [trace["error_deg"][i] for i in inside]
+    E = L["error"]
+    y_of = lambda v: E["top"] + E["height"] - (v - E["lo"]) / (E["hi"] - E["lo"]) * E["height"]  # noqa: E731
+    rows = chart_rows(page, "error", "b - g > 25 && r - g > 15")  # the error's purple, even a spike's faint tip
+    assert min(rows) <= y_of(max(errors)) + 1.5 and max(rows) >= y_of(min(errors)) - 1.5, (rows[0], rows[-1])
+
+    # scrubbing: the cursor where its time falls in the span; outside the span, none
+    scrub_to(page, 0.75)
+    expected = E["left"] + (0.75 - E["t0"]) / (E["t1"] - E["t0"]) * E["width"]
+    assert cursor_column(page, "error") == pytest.approx(expected, abs=2.0)
+    scrub_to(page, 2.0)
+    assert page.evaluate("""(() => {
+        const c = document.querySelector('canvas[data-chart="error"]');
+        const d = c.getContext('2d').getImageData(0, 0, c.width, c.height).data;
+        const counts = new Array(c.width).fill(0);
+        for (let i = 0; i < d.length; i += 4) if (d[i] > 180 && d[i + 1] < 60 && d[i + 2] < 60) counts[(i / 4) % c.width]++;
+        return Math.max(...counts); })()""") < 5
+    # playing: the clock runs, the charts stay zoomed
+    scrub_to(page, 0.4)
+    page.click("#play")
+    page.wait_for_timeout(400)
+    assert page.evaluate("window.twinClock.time") > 0.45
+    assert layouts(page)["duty"]["t0"] == pytest.approx(L["duty"]["t0"])
+    page.click("#play")
+
+    # back to the whole run: a double-click; zoomed again, the button
+    page.mouse.dblclick(x_at(0.5), y)
+    page.wait_for_timeout(200)
+    assert all(L["t0"] == 0 and L["t1"] == pytest.approx(duration) for L in layouts(page).values())
+    assert page.is_disabled("#whole-run")
+    page.mouse.move(x_at(1.0), y)
+    page.mouse.down()
+    page.mouse.move(x_at(2.0), y, steps=4)
+    page.mouse.up()
+    page.wait_for_timeout(200)
+    assert layouts(page)["valves"]["t0"] == pytest.approx(1.0, abs=0.02)
+    page.click("#whole-run")
+    page.wait_for_timeout(200)
+    assert all(L["t0"] == 0 and L["t1"] == pytest.approx(duration) for L in layouts(page).values())
