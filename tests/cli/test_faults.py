@@ -1331,3 +1331,26 @@ def test_the_probes_last_inputs_are_refused(tmp_path, capsys, monkeypatch, argv,
     assert main(argv) == 2
     _one_line_error(capsys, needle)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_a_stop_python_swallowed_during_a_sweep_stops_it_after_the_batch_it_came_in(tmp_path, capsys, monkeypatch):
+    """In a sweep, a swallowed stop is raised again once the batch it came in is stored: the sweep stops as on
+    Ctrl-C (exit 130, the finished batch kept for a resume), instead of running every batch."""
+    from twin.batch import sweep
+
+    plain = sweep.run_chunk
+
+    def run_chunk(chunk):
+        rows = plain(chunk)
+        _StopInsideDel(signal.SIGINT)
+        return rows
+
+    monkeypatch.setattr(sweep, "run_chunk", run_chunk)
+    out = tmp_path / "s"
+    assert main(["sweep", "--trajectory", "2,3", "--seed", "0-3", "--workers", "1", "--out", str(out)]) == 130
+    assert "interrupted: finished scenarios are kept" in capsys.readouterr().err
+    store = sweep.open_store(out)
+    try:
+        assert len(store.done()) == 4  # the first batch (one trajectory's four seeds), not the second
+    finally:
+        store.close()

@@ -31,6 +31,7 @@ from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 
 from twin.batch.grid import GridPoint
+from twin.batch.stops import raise_if_stopped
 from twin.batch.store import ResultStore
 from twin.exceptions import TwinError
 from twin.physics.trajectories import trajectory
@@ -148,6 +149,7 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
     if workers == 1:
         for chunk in chunks:
             on_done(run_chunk(chunk))
+            raise_if_stopped()
         return
     run_forked([(run_chunk, (chunk,)) for chunk in chunks], workers, on_done)
 
@@ -165,6 +167,7 @@ def run_forked(calls: Sequence[tuple[Callable, tuple]], workers: int, on_done: C
         futures = [pool.submit(function, *arguments) for function, arguments in calls]
         for future in concurrent.futures.as_completed(futures):
             on_done(future.result())
+            raise_if_stopped()  # a stop Python swallowed: what finished is handed on, the rest stopped
     except BaseException:
         # Ctrl-C, SIGTERM or an error: what finished has been handed to on_done; the calls in flight are
         # lost (at most one per worker), and the workers are stopped now rather than waited for.
@@ -249,6 +252,7 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
         while pending:
             done, pending = cluster(ray.wait, pending, num_returns=1)
             on_done(cluster(ray.get, done[0]))
+            raise_if_stopped()
     finally:  # best effort: a cluster already lost refuses these too, and must not hide why the sweep stopped
         with contextlib.suppress(ConnectionError):
             for ref in pending:

@@ -13,9 +13,9 @@ import sys
 import threading
 
 from twin.batch.lock import folder_lock
+from twin.batch.stops import raise_if_stopped, swallowed_stops_kept
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
-from twin.experiments.base import raise_if_stopped, swallowed_stops_kept
 from twin.physics.model import Orientation
 from twin.plants import PLANTS, Plant
 from twin.plants.as_built import EFFECTS, as_built_plant

@@ -33,6 +33,7 @@ import threading
 from collections.abc import Callable
 from typing import Any, ClassVar
 
+from twin.batch.stops import raise_if_stopped
 from twin.batch.tables import write_csv
 
 
@@ -153,39 +154,6 @@ def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:
 
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
-_swallowed_stops: list[KeyboardInterrupt] = []  # kept by swallowed_stops_kept(), raised by raise_if_stopped()
-
-
-@contextlib.contextmanager
-def swallowed_stops_kept():
-    """For the block: a Ctrl-C (or a stop signal taken as one) that Python swallowed, because it came while a
-    garbage collector's callback or a ``__del__`` ran ("Exception ignored in ..."), is kept instead of
-    printed, and :func:`raise_if_stopped` raises it again before any output goes into place, so the stop
-    is not lost. The previous hook afterwards, and every other unraisable error still goes to it."""
-    previous = sys.unraisablehook
-
-    def keep(unraisable) -> None:
-        if isinstance(unraisable.exc_value, KeyboardInterrupt):
-            _swallowed_stops.append(unraisable.exc_value)
-        else:
-            previous(unraisable)
-
-    sys.unraisablehook = keep
-    try:
-        yield
-    finally:
-        sys.unraisablehook = previous
-        _swallowed_stops.clear()
-
-
-def raise_if_stopped() -> None:
-    """KeyboardInterrupt if a stop was swallowed since the last call (:func:`swallowed_stops_kept`): called
-    where a command puts its outputs into place."""
-    if _swallowed_stops:
-        _swallowed_stops.clear()
-        raise KeyboardInterrupt
-
-
 @contextlib.contextmanager
 def stops_held():
     """Hold Ctrl-C, SIGTERM and SIGHUP for the block, then put back the handlers they had and deliver each that

@@ -56,8 +56,8 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
+from twin.batch.stops import raise_if_stopped
 from twin.batch.sweep import code_version, fork_pool, kill_pool
-from twin.experiments.base import raise_if_stopped
 from twin.experiments.reference import (
     THESIS_EXPERIMENT_RMSE_DEG,
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
@@ -405,6 +405,7 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
 
     def report(c: float, values: dict) -> None:
         nonlocal done
+        raise_if_stopped()  # a stop Python swallowed stops the fit here, not after it
         done += 1
         if progress is not None:
             progress(done, planned, stage, c, values)
