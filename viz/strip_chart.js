@@ -85,7 +85,7 @@ class StripCharts {
     for (const chart of this.charts) {
       const canvas = chart.canvas, id = chart.spec.id;
       canvas.style.cursor = "crosshair";
-      canvas.style.touchAction = "none";  // a finger's drag zooms too, not scrolls the panel
+      canvas.style.touchAction = "pan-y";  // a finger across zooms; up or down still scrolls the panel (a phone)
       canvas.title = "drag across to zoom every chart; double-click for the whole run";
       let start = null;  // the drag's first x (CSS px from the canvas's left) and time
       const x = (e) => e.clientX - canvas.getBoundingClientRect().left;

@@ -1288,6 +1288,9 @@ def test_other_errors_python_swallows_are_still_reported(tmp_path, monkeypatch):
     (["sweep", "--payload", "0:1_0:5", "--out", "x"], "bad value '0:1_0:5' for --payload"),
     (["whatif", "smc-phi", "--phis", "0.1_5", "--out", "x"], "--phis: numbers in m/s separated by commas"),
     (["whatif", "pva-rate", "--rates", "\u0664", "--out", "x"], "--rates: whole milliseconds separated by commas"),
+    (["run", "--trajectory", "\uff13"], "trajectory must be 1, 2, 3 or 4, got '\uff13'"),
+    (["whatif", "payload", "--trajectory", "1_0", "--out", "x"], "trajectory must be 1, 2, 3 or 4, got '1_0'"),
+    (["whatif", "next-experiment", "--pressure-step", "1_0", "--out", "x"], "expected a number of kPa, got '1_0'"),
 ])
 def test_numbers_in_pythons_other_spellings_are_refused(tmp_path, capsys, monkeypatch, argv, needle):
     """Flags took Python's other number spellings: ``5_0`` as 50, full-width and other scripts' digits (a
@@ -1295,7 +1298,8 @@ def test_numbers_in_pythons_other_spellings_are_refused(tmp_path, capsys, monkey
     digits, a point and an exponent only; nothing is written."""
     monkeypatch.chdir(tmp_path)
     try:
-        code = main([*argv[:1], *(["--controller", "ffpva", "--trajectory", "2"] if argv[0] == "run" else []),
+        scenario = {"--controller": "ffpva", "--trajectory": "2"} if argv[0] == "run" else {}
+        code = main([*argv[:1], *(part for flag, value in scenario.items() if flag not in argv for part in (flag, value)),
                      *argv[1:]])
     except SystemExit as stopped:  # a flag's own type: argparse's exit
         code = stopped.code
@@ -1322,6 +1326,8 @@ def test_numbers_written_plainly_still_read():
      "--compare controller=smc: the first joint has these settings already: nothing to compare"),
     (["run", "--plant", "as-built", "--without", "stiction", "--controller", "smc", "--trajectory", "2", "--html",
       "x.html", "--compare", "without=stiction,seed=0"], "--compare without=stiction,seed=0: the first joint has"),
+    (["run", "--controller", "smc", "--trajectory", "2", "--html", "x.html", "--compare", "supply-kpa=300"],
+     "--compare supply-kpa=300: the first joint has"),  # the thesis plant's own supply, named
 ])
 def test_the_probes_last_inputs_are_refused(tmp_path, capsys, monkeypatch, argv, needle):
     """What a helper's probe (stop 40) left: an empty `--plant` ran the default plant's study; a payload of
@@ -1352,5 +1358,44 @@ def test_a_stop_python_swallowed_during_a_sweep_stops_it_after_the_batch_it_came
     store = sweep.open_store(out)
     try:
         assert len(store.done()) == 4  # the first batch (one trajectory's four seeds), not the second
+    finally:
+        store.close()
+
+
+def test_a_swallowed_stop_outlives_an_inner_block_that_ends_first():
+    """A command nests the keeping of swallowed stops (``main`` and its output folder each keep them): the inner
+    block's end must not forget a stop the outer block has yet to raise (a review caught the first version)."""
+    from twin.batch.stops import raise_if_stopped, swallowed_stops_kept
+
+    hook = sys.unraisablehook
+    with pytest.raises(KeyboardInterrupt), swallowed_stops_kept():
+        with swallowed_stops_kept():
+            _StopInsideDel(signal.SIGINT)
+        raise_if_stopped()
+    assert sys.unraisablehook is hook
+    raise_if_stopped()  # nothing kept once the outer block has ended
+
+
+def test_a_stop_python_swallowed_in_a_forked_sweep_stops_it_after_that_batch(tmp_path, capsys, monkeypatch):
+    """The same on two worker processes: the stop is swallowed in the parent as it stores a finished batch."""
+    from twin.batch import sweep
+
+    plain = sweep.ResultStore.add
+    calls = []
+
+    def add(self, rows):
+        plain(self, rows)
+        calls.append(len(rows))
+        if len(calls) == 1:
+            _StopInsideDel(signal.SIGTERM)
+
+    monkeypatch.setattr(sweep.ResultStore, "add", add)
+    out = tmp_path / "s"
+    assert main(["sweep", "--trajectory", "2,3", "--seed", "0-3", "--workers", "2", "--out", str(out)]) == 130
+    assert "interrupted: finished scenarios are kept" in capsys.readouterr().err
+    assert len(calls) == 1  # stopped after the first batch it stored, whichever finished first
+    store = sweep.open_store(out)
+    try:
+        assert len(store.done()) == calls[0]
     finally:
         store.close()

@@ -11,14 +11,23 @@ import contextlib
 import sys
 
 _swallowed_stops: list[KeyboardInterrupt] = []  # kept by swallowed_stops_kept(), raised by raise_if_stopped()
+_depth = [0]  # swallowed_stops_kept() blocks entered and not yet left (a command nests them)
 
 
 @contextlib.contextmanager
 def swallowed_stops_kept():
     """For the block: a Ctrl-C (or a stop signal taken as one) that Python swallowed, because it came while a
     garbage collector's callback or a ``__del__`` ran ("Exception ignored in ..."), is kept instead of
-    printed, and :func:`raise_if_stopped` raises it again before any output goes into place, so the stop
-    is not lost. The previous hook afterwards, and every other unraisable error still goes to it."""
+    printed, and :func:`raise_if_stopped` raises it again, so the stop is not lost. Nested blocks share the
+    outermost's hook and its kept stops (an inner block's end must not forget one the outer has yet to
+    raise). The previous hook afterwards, and every other unraisable error still goes to it."""
+    if _depth[0]:
+        _depth[0] += 1
+        try:
+            yield
+        finally:
+            _depth[0] -= 1
+        return
     previous = sys.unraisablehook
 
     def keep(unraisable) -> None:
@@ -27,11 +36,11 @@ def swallowed_stops_kept():
         else:
             previous(unraisable)
 
-    sys.unraisablehook = keep
+    sys.unraisablehook, _depth[0] = keep, 1
     try:
         yield
     finally:
-        sys.unraisablehook = previous
+        sys.unraisablehook, _depth[0] = previous, 0
         _swallowed_stops.clear()
 
 

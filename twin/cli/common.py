@@ -34,7 +34,7 @@ class Parser(argparse.ArgumentParser):
 def add_scenario_arguments(parser: argparse.ArgumentParser) -> None:
     """The scenario flags shared by ``run`` and later commands."""
     parser.add_argument("--controller", choices=CONTROLLER_NAMES, required=True)
-    parser.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), required=True)
+    parser.add_argument("--trajectory", type=arguments.trajectory, required=True, metavar="{1,2,3,4}")
     parser.add_argument("--payload", type=arguments.grams, default=0.0, metavar="GRAMS", help="mass at the link tip (g)")
     parser.add_argument("--orientation", choices=[o.value for o in Orientation], default="horizontal")
     parser.add_argument("--plant", choices=sorted(PLANTS), default="thesis")
@@ -96,6 +96,11 @@ def _flag_values(settings: dict[str, str]) -> argparse.Namespace:
     return namespace
 
 
+def _as_run(scenario: Scenario, field: str):
+    """``scenario``'s ``field`` as the run takes it (a supply pressure not given is the plant's)."""
+    return scenario.supply if field == "supply_pressure" else getattr(scenario, field)
+
+
 def compare_of(args: argparse.Namespace, settings: dict[str, str]):
     """:class:`twin.envs.live.Compare` for ``settings`` on top of the command's scenario flags."""
     from twin.envs.live import Compare
@@ -113,7 +118,7 @@ def compare_of(args: argparse.Namespace, settings: dict[str, str]):
         raise InvalidScenario(f"--compare {','.join(f'{k}={v}' for k, v in settings.items())}: {error}") from None
     changes = {COMPARE_FIELDS[key]: getattr(scenario, COMPARE_FIELDS[key]) for key in settings}
     first = scenario_from(args)
-    if all(getattr(first, field) == value for field, value in changes.items()):
+    if all(_as_run(first, field) == _as_run(scenario, field) for field in changes):
         raise InvalidScenario(f"--compare {','.join(f'{k}={v}' for k, v in settings.items())}: the first joint "
                               "has these settings already: nothing to compare")
     return Compare(changes=changes, text=dict(settings))

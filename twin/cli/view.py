@@ -6,6 +6,7 @@ import argparse
 import sys
 import time
 
+from twin.batch.stops import raise_if_stopped
 from twin.cli.common import (
     EXIT_INTERRUPTED,
     add_scenario_arguments,
@@ -29,6 +30,7 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if args.duration is not None:
         stop_at = time.monotonic() + args.duration
         viewer.on_frame = lambda: viewer.shutdown() if time.monotonic() >= stop_at else None
+    raise_if_stopped()  # one swallowed while the model was built: stop before serving (serving takes a stop itself)
     with sigterm_as_interrupt():  # stop (and write --html) on SIGTERM too
         try:
             viewer.start()

@@ -83,6 +83,8 @@ workers = checked(int, lambda v: 1 <= v <= MAX_WORKERS,
 port = checked(int, lambda v: 0 <= v <= 65535, "port must be an integer in [0, 65535]")
 speed = checked(float, lambda v: 0 < v <= 10, "speed must be in (0, 10] times real time")
 seconds = checked(float, lambda v: v > 0, "duration must be a positive number of seconds")
+trajectory = checked(int, lambda v: 1 <= v <= 4, "trajectory must be 1, 2, 3 or 4")
+kpa_number = checked(float, lambda v: True, "expected a number of kPa")  # its range: the command's check
 
 
 def host(text: str) -> str:

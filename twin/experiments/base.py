@@ -154,6 +154,8 @@ def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:
 
 
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+
+
 @contextlib.contextmanager
 def stops_held():
     """Hold Ctrl-C, SIGTERM and SIGHUP for the block, then put back the handlers they had and deliver each that

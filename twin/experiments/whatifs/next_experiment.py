@@ -312,7 +312,7 @@ class NextExperimentWhatIf(Experiment):
         ensemble.add_ensemble_arguments(parser, seeds=4)
         parser.add_argument("--prediction-seeds", type=arguments.seed_count, default=3, metavar="N",
                             help="seeds per Chapter 6 cell and member for the predictions (default 3)")
-        parser.add_argument("--pressure-step", type=float, default=10.0, metavar="KPA",
+        parser.add_argument("--pressure-step", type=arguments.kpa_number, default=10.0, metavar="KPA",
                             help="supply pressure step of the breakaway map, kPa (default 10)")
 
     def check(self, args: argparse.Namespace) -> None:

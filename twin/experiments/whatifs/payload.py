@@ -57,7 +57,7 @@ class PayloadWhatIf(Experiment):
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
         add_common_arguments(parser, self.default_plant)
         parser.add_argument("--payloads", default="0:30:2.5", metavar="LIST", help="grams (default 0:30:2.5)")
-        parser.add_argument("--trajectory", type=int, choices=(1, 2, 3, 4), default=1)
+        parser.add_argument("--trajectory", type=arguments.trajectory, default=1, metavar="{1,2,3,4}")
         parser.add_argument("--workers", type=arguments.workers, default=None, help="processes (default: all cores)")
 
     def check(self, args: argparse.Namespace) -> None:
