@@ -198,3 +198,22 @@ def test_bad_arguments_are_rejected():
         joint_env.load("track", trajectory=9)
     with pytest.raises(InvalidScenario):
         joint_env.load("track", action_period=1.5e-3)
+
+
+@pytest.mark.parametrize("kwargs, message", [
+    ({"seed": 2**32}, "seed must be from 0 to 2\\^32 - 1"),
+    ({"action_period": float("nan")}, "action period of nan s is not a whole number"),
+    ({"action_period": float("inf")}, "action period of inf s is not a whole number"),
+    ({"action_period": 100.0}, "longer than the episode"),
+])
+def test_the_environment_refuses_what_it_cannot_run_in_one_line(kwargs, message):
+    """A helper's probe (stop 41): a seed from 2^32 up (which `twin run` takes) raised NumPy's own error from
+    dm_control's random state; an action period of nan or inf a raw ValueError or OverflowError; one of 100 s
+    ran a 3 s episode as one step of 100,000 ticks. Each is now an InvalidScenario naming the value."""
+    with pytest.raises(InvalidScenario, match=message):
+        joint_env.load("track", trajectory=1, **kwargs)
+
+
+def test_the_largest_seed_the_environment_takes_runs():
+    env = joint_env.load("track", trajectory=2, seed=2**32 - 1)
+    assert env.reset().first()

@@ -26,6 +26,7 @@ import multiprocessing
 import os
 import pathlib
 import signal
+import threading
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
@@ -222,6 +223,23 @@ def worker_setup() -> None:
         os._exit(1)
 
 
+@contextlib.contextmanager
+def _stop_handlers_kept():
+    """Put back the stop signals' handlers after the block. ``ray.init`` takes SIGTERM over (a handler of its own
+    in Python, and its C++ crash reporter underneath): a kill then ended a sweep with exit 134 and a stack dump
+    instead of stopping it as Ctrl-C does (a helper's probe, stop 41). Only the main thread may set handlers."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
+    try:
+        yield
+    finally:
+        for signum, handler in before.items():
+            if handler is not None:  # None: set outside Python, which cannot be put back from here
+                signal.signal(signum, handler)
+
+
 def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
          on_done: Callable[[list[dict]], None]) -> None:
     """Chunks as Ray tasks, sized for ``workers`` or else for every CPU of the cluster."""
@@ -243,7 +261,8 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
 
     started_here = not ray.is_initialized()
     if started_here:  # log_to_driver=False: worker prints would flood the progress bar
-        cluster(ray.init, address=where, include_dashboard=False, log_to_driver=False)
+        with _stop_handlers_kept():
+            cluster(ray.init, address=where, include_dashboard=False, log_to_driver=False)
     pending = []
     try:
         cpus = workers or int(cluster(ray.cluster_resources).get("CPU", 1))

@@ -263,6 +263,9 @@ def episode_steps(duration: float, action_period: float) -> int:
     return math.ceil(round(duration / action_period, 9))
 
 
+MAX_TASK_SEED = 2**32 - 1  # dm_control's task seeds a NumPy RandomState, which takes no more
+
+
 def load(task: str = "track", *, trajectory: int | None = 1, action_period: float | None = None,
          seed: int = 0, controller: str = "ffpva", **scenario) -> control.Environment:
     """A dm_control Environment of the joint.
@@ -278,6 +281,9 @@ def load(task: str = "track", *, trajectory: int | None = 1, action_period: floa
         raise InvalidScenario(f"unknown trajectory {trajectory!r}: choose 1-4 or None (random)")
     randomise_load = task == "hold" and "payload" not in scenario and "orientation" not in scenario
     base_scenario = Scenario(controller, trajectory or 1, seed=seed, **scenario)
+    if seed > MAX_TASK_SEED:  # twin run takes up to 2^63 - 1; dm_control's random state raised a NumPy error
+        raise InvalidScenario(f"the environment's seed must be from 0 to 2^32 - 1 (its task's random state), "
+                              f"got {seed}")
     if action_period is None:
         action_period = base_scenario.preset.params.valves.pwm_period
     root = build_mjcf(params=base_scenario.preset.params, payload_mass=base_scenario.payload,
@@ -287,6 +293,9 @@ def load(task: str = "track", *, trajectory: int | None = 1, action_period: floa
     whole_ticks(action_period, physics.timestep(), what="action period")
     joint_task = JointTask(name=task, trajectory_number=trajectory if task == "track" else None,
                            scenario=base_scenario, randomise_load=randomise_load, seed=seed)
+    if action_period > joint_task.duration:  # one step would run the whole episode and past it
+        raise InvalidScenario(f"action period of {action_period} s is longer than the episode "
+                              f"({joint_task.duration:g} s)")
     physics.begin(joint_task.default_episode(), ticks=physics.ticks_for(joint_task.duration))
     steps = episode_steps(joint_task.duration, action_period)
     # dm_control ends an episode once step_count >= time_limit / control_timestep.
