@@ -24,6 +24,7 @@ review caught it on 2026-11-27 before the result was kept.)
 
 from __future__ import annotations
 
+import argparse
 import math
 import pathlib
 
@@ -113,5 +114,6 @@ def _t1_ending(runs: list) -> str:
             f"{np.nanmax(np.abs(sse)):.2f} off, {int(np.sum(np.abs(sse) > 1.0))} of {len(sse)} over 1 deg")
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -29,6 +29,8 @@ cells, which the README sums up); a slow test in tests/experiments/test_trials.p
 
 from __future__ import annotations
 
+import argparse
+
 import numpy as np
 
 from twin.experiments import calibrate
@@ -73,5 +75,6 @@ def main() -> None:
                   f"{' / '.join(t3[:6])}; {' / '.join(t3[6:])}", flush=True)
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

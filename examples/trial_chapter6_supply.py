@@ -25,6 +25,7 @@ The result is recorded in docs/prediction.md.
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
@@ -86,5 +87,6 @@ def main() -> None:
         print(f"{kpa:g} kPa: T1 {within} of 10, 13.5 g V {heavy}; T3 {cells}; smc ahead {ahead} of 6", flush=True)
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

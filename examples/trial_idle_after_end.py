@@ -13,6 +13,7 @@ fastest, and each pair's) and whether every RMSE is the same bits.
 
 from __future__ import annotations
 
+import argparse
 import time
 
 import twin.sim.simulation as simulation
@@ -48,5 +49,6 @@ def main() -> None:
           f"pairs {min(pairs):.2f}-{max(pairs):.2f}; same RMSE bits: {rmse['idle'] == rmse['run on']}")
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -21,6 +21,7 @@ Its result (2026-11-26) is in docs/prediction.md.
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
@@ -70,5 +71,6 @@ def main() -> None:
               f"{t3[name][0].mean_rmse:.2f} / {t3[name][1].mean_rmse:.2f}", flush=True)
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -27,6 +27,7 @@ reading of "±0.02 mm" would give), seeds 40-59 (docs/prediction.md quotes it).
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import json
 import math
@@ -141,5 +142,6 @@ def main() -> None:
     prediction_noise()
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -13,6 +13,7 @@ in docs/investigations.md.
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
@@ -49,5 +50,6 @@ def main() -> None:
             print(f"{','.join(off) or '(nothing: as committed)':32s} | {cells[0]} | {cells[1]}", flush=True)
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -13,6 +13,7 @@ RMSE over 0 g flat, and the error when the move ends (1.0 s; mean and std over t
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import pathlib
@@ -54,5 +55,6 @@ def main() -> None:
                   f"{end.mean():+6.2f} ± {end.std(ddof=1):.2f}")
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -28,6 +28,7 @@ these changes: the calibrated values stay the eighth refit's. The result is reco
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import json
 import math
@@ -142,5 +143,6 @@ def main() -> None:
         print(f"{label:28s} T2 {means[0]:.2f} | T3 {means[1]:.2f}", flush=True)
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

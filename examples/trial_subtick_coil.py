@@ -12,6 +12,7 @@ recorded in docs/investigations.md.
 
 from __future__ import annotations
 
+import argparse
 import json
 import math
 import pathlib
@@ -91,5 +92,6 @@ def main() -> None:
                                       for c in ("ffpva", "smc")))
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

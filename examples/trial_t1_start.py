@@ -19,6 +19,7 @@ at 30 deg. The result is recorded in docs/investigations.md.
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
@@ -83,5 +84,6 @@ def main() -> None:
         trajectories.START = committed  # T1, T2 and T4 start where they did, for whatever runs after
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

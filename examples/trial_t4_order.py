@@ -11,6 +11,8 @@ docs/investigations.md.
 
 from __future__ import annotations
 
+import argparse
+
 from twin.experiments import calibrate
 from twin.plants.as_built import NINTH_REFIT_FILE, ensemble_values
 
@@ -29,5 +31,6 @@ def main() -> None:
                   f"SMC {fresh[1].mean_rmse:.3f}", flush=True)
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -13,6 +13,7 @@ is recorded in docs/investigations.md.
 
 from __future__ import annotations
 
+import argparse
 import dataclasses
 import json
 import math
@@ -57,5 +58,6 @@ def main() -> None:
                   f"{np.mean(after):8.2f}  {np.mean(error[:, -1]):+5.2f} +- {np.std(error[:, -1]):.2f}")
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()
