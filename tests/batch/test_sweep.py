@@ -476,3 +476,19 @@ def test_a_kill_stops_a_ray_sweep_as_ctrl_c_does(tmp_path):
     _, err = proc.communicate(timeout=120)
     assert proc.returncode == 130, err[-2000:]
     assert "interrupted: finished scenarios are kept" in err and "SIGTERM received" not in err
+
+
+@pytest.mark.slow  # Ray looks for a cluster: a few seconds
+def test_ray_address_auto_with_no_cluster_leaves_nothing(tmp_path):
+    """`--ray-address auto` with no Ray cluster running is found only when Ray starts; it left the folder, its
+    lock and an empty store, and said "finished scenarios are kept" of none (a helper's probe, stop 41). Now a
+    one-line error that no scenario ran, and a folder made for it goes again."""
+    pytest.importorskip("ray")
+    env = {key: value for key, value in os.environ.items() if key != "RAY_ADDRESS"}
+    proc = subprocess.run([sys.executable, "-m", "twin", "sweep", "--seed", "0", "--trajectory", "2", "--backend",
+                           "ray", "--ray-address", "auto", "--out", "s"], cwd=tmp_path,
+                          env={**env, "PYTHONPATH": str(ROOT)}, capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 2, proc.stderr[-2000:]
+    assert proc.stderr.strip().splitlines()[-1].endswith("no scenario ran")
+    assert "kept" not in proc.stderr.strip().splitlines()[-1]
+    assert not (tmp_path / "s").exists()

@@ -47,6 +47,10 @@ class ClusterUnreachable(TwinError):
     """Ray could not connect to the cluster it was pointed at."""
 
 
+class ClusterNotStarted(ClusterUnreachable):
+    """Ray could not start or find its cluster: no scenario ran."""
+
+
 class WorkerLost(TwinError):
     """A worker process died mid-sweep (killed, or out of memory)."""
 
@@ -261,8 +265,12 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
 
     started_here = not ray.is_initialized()
     if started_here:  # log_to_driver=False: worker prints would flood the progress bar
-        with _stop_handlers_kept():
-            cluster(ray.init, address=where, include_dashboard=False, log_to_driver=False)
+        try:
+            with _stop_handlers_kept():
+                ray.init(address=where, include_dashboard=False, log_to_driver=False)
+        except ConnectionError as error:  # ``auto`` with no cluster running: found only here
+            raise ClusterNotStarted(f"could not reach the Ray cluster at {where or 'a local Ray'}: "
+                                    f"{str(error).splitlines()[0]}; no scenario ran") from None
     pending = []
     try:
         cpus = workers or int(cluster(ray.cluster_resources).get("CPU", 1))

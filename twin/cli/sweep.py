@@ -39,8 +39,14 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
         check_ray_address(address, "--ray-address" if args.ray_address else "RAY_ADDRESS")
     # one writer per folder (a second sweep into it is refused, naming this one); SIGTERM stops it as Ctrl-C
     # does; the folder stays whatever stops the sweep: its store keeps the finished scenarios
-    with output_folder(args.out, keep_on_failure=True):
-        return _sweep(args, points)
+    with output_folder(args.out, keep_on_failure=True) as folder:
+        from twin.batch.sweep import ClusterNotStarted
+
+        try:
+            return _sweep(args, points)
+        except ClusterNotStarted:
+            folder.keep = False  # no scenario ran: a folder made here goes again, as for any refused input
+            raise
 
 
 RAY_CONNECT_TIMEOUT = 5.0  # s to reach a cluster's head before the sweep is refused (Ray itself retries for minutes)
