@@ -881,9 +881,9 @@ def test_ray_failing_to_connect_is_not_read_as_a_file_that_cannot_be_written(mon
 
     monkeypatch.setattr(ray, "is_initialized", lambda: False)
     monkeypatch.setattr(ray, "init", refuse)
-    with pytest.raises(sweep.ClusterUnreachable, match="^lost or could not reach the Ray cluster at auto: Could not "
-                                                       "find any running Ray instance.; finished scenarios are kept"):
-        sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)
+    with pytest.raises(sweep.ClusterNotStarted, match="^could not reach the Ray cluster at auto: Could not find any "
+                                                      "running Ray instance.; no scenario ran$"):  # (stop 41: was
+        sweep._ray(grid.expand({"seed": [0]}), None, "auto", lambda rows: None)  # "finished scenarios are kept")
     monkeypatch.setattr(ray, "is_initialized", lambda: True)  # connected; then the connection breaks mid-sweep
     monkeypatch.setattr(ray, "cluster_resources", lambda: {"CPU": 1})
     monkeypatch.setattr(ray, "remote", lambda function: type("Remote", (), {"remote": lambda self, chunk: chunk})())
