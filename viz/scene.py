@@ -175,8 +175,7 @@ class JointScene:
         shell = m.geom("housing_shell").id
         low[2] = min(low[2], -m.geom_size[shell][2])
         for end in self._gravity_arrow_ends():
-            reach = GRAVITY_ARROW_HEAD_RADIUS
-            low, high = np.minimum(low, end - reach), np.maximum(high, end + reach)
+            low, high = np.minimum(low, end - GRAVITY_ARROW_HEAD_RADIUS), np.maximum(high, end + GRAVITY_ARROW_HEAD_RADIUS)
         return low - VIEW_MARGIN, high + VIEW_MARGIN
 
     def setup_commands(self) -> list[dict]:

@@ -1,17 +1,39 @@
-"""Stops that Python swallowed: a Ctrl-C (or a stop signal a command takes as one) that comes while a garbage
-collector's callback or a ``__del__`` runs raises its KeyboardInterrupt there, and Python swallows it
-("Exception ignored in ..."), so the command would run on as if no stop had come. :func:`swallowed_stops_kept`
-keeps such a stop for a command's length; :func:`raise_if_stopped`, called where work is handed on (a finished
-batch) or outputs go into place, raises it again.
+"""Stop signals, and stops that Python swallowed.
+
+:data:`STOP_SIGNALS` are the signals a command takes as a stop; :func:`handlers_put_back` restores their
+handlers after code that takes them over (``ray.init`` does). A Ctrl-C (or a stop signal a command takes as
+one) that comes while a garbage collector's callback or a ``__del__`` runs raises its KeyboardInterrupt there,
+and Python swallows it ("Exception ignored in ..."), so the command would run on as if no stop had come.
+:func:`swallowed_stops_kept` keeps such a stop for a command's length; :func:`raise_if_stopped`, called where
+work is handed on (a finished batch) or outputs go into place, raises it again.
 """
 
 from __future__ import annotations
 
 import contextlib
+import signal
 import sys
+import threading
 
+STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)  # Ctrl-C, a kill, a closed terminal
 _swallowed_stops: list[KeyboardInterrupt] = []  # kept by swallowed_stops_kept(), raised by raise_if_stopped()
-_depth = [0]  # swallowed_stops_kept() blocks entered and not yet left (a command nests them)
+_depth = 0  # swallowed_stops_kept() blocks entered and not yet left (a command nests them)
+
+
+@contextlib.contextmanager
+def handlers_put_back():
+    """The stop signals' handlers as they were before the block, put back after it (a handler set outside
+    Python, ``None``, cannot be, and is left). Only the main thread may set handlers: elsewhere a no-op."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    before = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
+    try:
+        yield
+    finally:
+        for signum, handler in before.items():
+            if handler is not None:
+                signal.signal(signum, handler)
 
 
 @contextlib.contextmanager
@@ -21,12 +43,13 @@ def swallowed_stops_kept():
     printed, and :func:`raise_if_stopped` raises it again, so the stop is not lost. Nested blocks share the
     outermost's hook and its kept stops (an inner block's end must not forget one the outer has yet to
     raise). The previous hook afterwards, and every other unraisable error still goes to it."""
-    if _depth[0]:
-        _depth[0] += 1
+    global _depth
+    if _depth:
+        _depth += 1
         try:
             yield
         finally:
-            _depth[0] -= 1
+            _depth -= 1
         return
     previous = sys.unraisablehook
 
@@ -36,11 +59,11 @@ def swallowed_stops_kept():
         else:
             previous(unraisable)
 
-    sys.unraisablehook, _depth[0] = keep, 1
+    sys.unraisablehook, _depth = keep, 1
     try:
         yield
     finally:
-        sys.unraisablehook, _depth[0] = previous, 0
+        sys.unraisablehook, _depth = previous, 0
         _swallowed_stops.clear()
 
 

@@ -26,13 +26,12 @@ import multiprocessing
 import os
 import pathlib
 import signal
-import threading
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
 
 from twin.batch.grid import GridPoint
-from twin.batch.stops import raise_if_stopped
+from twin.batch.stops import handlers_put_back, raise_if_stopped
 from twin.batch.store import ResultStore
 from twin.exceptions import TwinError
 from twin.physics.trajectories import trajectory
@@ -154,7 +153,6 @@ def _local(points: Sequence[GridPoint], workers: int, on_done: Callable[[list[di
     if workers == 1:
         for chunk in chunks:
             on_done(run_chunk(chunk))
-            raise_if_stopped()
         return
     run_forked([(run_chunk, (chunk,)) for chunk in chunks], workers, on_done)
 
@@ -227,23 +225,6 @@ def worker_setup() -> None:
         os._exit(1)
 
 
-@contextlib.contextmanager
-def _stop_handlers_kept():
-    """Put back the stop signals' handlers after the block. ``ray.init`` takes SIGTERM over (a handler of its own
-    in Python, and its C++ crash reporter underneath): a kill then ended a sweep with exit 134 and a stack dump
-    instead of stopping it as Ctrl-C does (a helper's probe, stop 41). Only the main thread may set handlers."""
-    if threading.current_thread() is not threading.main_thread():
-        yield
-        return
-    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)}
-    try:
-        yield
-    finally:
-        for signum, handler in before.items():
-            if handler is not None:  # None: set outside Python, which cannot be put back from here
-                signal.signal(signum, handler)
-
-
 def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
          on_done: Callable[[list[dict]], None]) -> None:
     """Chunks as Ray tasks, sized for ``workers`` or else for every CPU of the cluster."""
@@ -265,8 +246,8 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
 
     started_here = not ray.is_initialized()
     if started_here:  # log_to_driver=False: worker prints would flood the progress bar
-        try:
-            with _stop_handlers_kept():
+        try:  # ray.init takes SIGTERM over: a kill then ended the sweep with exit 134 and a C++ stack dump
+            with handlers_put_back():
                 ray.init(address=where, include_dashboard=False, log_to_driver=False)
         except ConnectionError as error:  # ``auto`` with no cluster running: found only here
             raise ClusterNotStarted(f"could not reach the Ray cluster at {where or 'a local Ray'}: "
@@ -279,7 +260,6 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
         while pending:
             done, pending = cluster(ray.wait, pending, num_returns=1)
             on_done(cluster(ray.get, done[0]))
-            raise_if_stopped()
     finally:  # best effort: a cluster already lost refuses these too, and must not hide why the sweep stopped
         with contextlib.suppress(ConnectionError):
             for ref in pending:
@@ -318,6 +298,7 @@ def run_sweep(points: Sequence[GridPoint], *, out: pathlib.Path, workers: int | 
             store.add(rows)
             if progress is not None:
                 progress(len(rows))
+            raise_if_stopped()  # a stop Python swallowed: this batch is stored, the rest stopped (every backend)
 
         try:
             if backend == "ray":

@@ -33,7 +33,7 @@ import threading
 from collections.abc import Callable
 from typing import Any, ClassVar
 
-from twin.batch.stops import raise_if_stopped
+from twin.batch.stops import STOP_SIGNALS, raise_if_stopped
 from twin.batch.tables import write_csv
 
 
@@ -151,9 +151,6 @@ def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:
     for name in names:
         if (out / name).is_dir():
             raise IsADirectoryError(errno.EISDIR, "a folder is in the way of this file", str(out / name))
-
-
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 @contextlib.contextmanager

@@ -8,7 +8,6 @@ import sys
 from collections.abc import Callable, Sequence
 
 from twin.batch import grid
-from twin.batch.grid import plain_number
 from twin.exceptions import InvalidScenario
 from twin.experiments.arguments import seed_count
 from twin.plants import PLANTS
@@ -40,7 +39,7 @@ def refuse_oversized(runs: int, what: str, *, at_most: bool = False) -> None:
                               f"{grid.MAX_POINTS:,} one command takes")
 
 
-def number_list(text: str, flag: str, what: str, convert=plain_number) -> list:
+def number_list(text: str, flag: str, what: str, convert=grid.plain_number) -> list:
     """``flag``'s comma-separated values, each through ``convert``, without repeats, sorted; a one-line error
     naming ``flag`` and ``what`` it takes ("--phis: numbers in m/s separated by commas, got '0.2,,0.3'") for an
     empty or unreadable item. Ranges are the caller's to check."""
