@@ -19,6 +19,8 @@ that first. Nothing is refitted around the delay. The result is recorded in docs
 fixed to the tick, that did not delay a 16 ms law's pulses, only cut or stretched their first ticks; a
 review caught it on 2026-11-27 before the result was kept.)
 
+About 1 min on 2 cores.
+
     python examples/trial_actuation_delay.py
 """
 

@@ -24,6 +24,8 @@ Nothing is refitted around the moved value, and nothing here is installed: past 
 fit. The result is recorded in docs/investigations.md (PVA T1 and the lag) and docs/prediction.md (the air and the T3
 cells, which the README sums up); a slow test in tests/experiments/test_trials.py holds the printed table.
 
+About 9 min on 2 cores.
+
     python examples/trial_chamber_buildup.py
 """
 

@@ -8,6 +8,8 @@ horizontal, seeds 40-79, on the committed preset (the ninth refit's, ``twin/plan
 RMSE and the cost (13.5 g over 0 g) with its paired standard error. Its result (2026-11-26) is
 in docs/investigations.md.
 
+About 65 s on 2 cores.
+
     python examples/trial_payload_cost_effects.py
 """
 

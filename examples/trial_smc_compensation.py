@@ -22,6 +22,8 @@ vertical) with both laws, to show what each reading would predict there and whic
 what-if beside the blind prediction, which stays as committed. Nothing is refitted. The result is
 recorded in docs/studies-and-whatifs.md.
 
+About 40 s on 2 cores for either preset.
+
     python examples/trial_smc_compensation.py [--preset ninth|committed]
 """
 

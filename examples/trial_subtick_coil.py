@@ -7,6 +7,8 @@ committed as-built preset both ways (FF + PVA and sliding mode, T1-T4, seeds 0-9
 compiled valve kernels for sub-tick versions, and prints the mean RMSE per trajectory (deg). The result is
 recorded in docs/investigations.md.
 
+About 10 s on 2 cores.
+
     python examples/trial_subtick_coil.py
 """
 

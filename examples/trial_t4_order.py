@@ -6,6 +6,8 @@ calibration's ensemble (the ninth refit's, ``twin/plants/data/ninth_refit.json``
 ran), and prints the members' profiled values and the four means. Its result (2026-11-26) is in
 docs/investigations.md.
 
+About 40 s on 2 cores.
+
     python examples/trial_t4_order.py
 """
 

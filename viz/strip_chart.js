@@ -7,7 +7,8 @@
 //    supply_kpa, valves: [[time, [V1, V2, V3, V4]], ...] (each change)}
 // Every chart draws every trace over the same time window [t0, t1]: the first joint in solid lines,
 // compare mode's second joint dashed and in a tint, with a legend. A series that the second joint draws otherwise
-// says how (``compare``: its legend name, colour and dash): its chambers A and B, in one tint, looked alike.
+// says how (``compare``: its legend name, colour and dash): its chambers A and B, in one tint, looked alike; its
+// supply, dotted teal, shares the first's legend entry (``both``).
 "use strict";
 
 const TWIN_COMPARE_TINT = "#12a5b0";  // teal, as the second joint in the 3D view (viz/scene.py COMPARE_TINT)
@@ -24,7 +25,7 @@ const TWIN_CHARTS = [
     {key: "pressure_a_kpa", label: "chamber A", color: "#d35400", compare: {label: "A"}},
     {key: "pressure_b_kpa", label: "chamber B", color: "#1e8449",
      compare: {label: "B", color: TWIN_COMPARE_DARK, dash: [8, 2, 2, 2]}},
-    {key: "supply_kpa", label: "supply", color: "#555555", dash: [1, 3]}]},
+    {key: "supply_kpa", label: "supply", color: "#555555", dash: [1, 3], compare: {both: true}}]},
   {id: "valves", title: "valves (open)", unit: "", kind: "valves"},
 ];
 
@@ -253,6 +254,7 @@ class StripCharts {
       ctx.restore();
       chart.legend = this._legend(ctx, spec, traces.length, left + width, 11,
                                   left + ctx.measureText(spec.title + " (" + spec.unit + ")").width + 8);
+      chart.legendBoth = this._both;
     }
     if (this.selection) {  // a drag under way: the span it will zoom to
       const [a, b] = this.selection.map((t) => Math.min(Math.max(xOf(t), left), left + width));
@@ -273,40 +275,54 @@ class StripCharts {
   // The legend, right-aligned between ``leftmost`` (the title's end) and ``right``: in a smaller font when
   // it does not fit, and only then without its last series (the first series, as chamber A, stays; so do
   // the compare joint's entries: "compare" on both pages, the page's title and info say what it is, or one per
-  // series the second joint draws its own way, "compare A" and "compare B"). Returns the names drawn.
+  // series the second joint draws its own way, "compare A" and "compare B"). A series marked ``compare.both``
+  // (the supply) takes no entry of its own for the second joint: its entry shows the second joint's line beside
+  // the first's. Returns the names drawn; ``this._both`` the names drawn with both lines.
   _legend(ctx, spec, count, right, y, leftmost = 0) {
     ctx.textAlign = "right";
     ctx.textBaseline = "alphabetic";
     let x = right;
     const items = [];
-    for (const s of spec.series) items.push([s.label, s.color, s.dash || []]);
+    for (const s of spec.series) {
+      const both = count > 1 && s.compare && s.compare.both ? twinCompareStyle(s) : null;
+      items.push([s.label, s.color, s.dash || [], both]);
+    }
     const compares = [];
     if (count > 1) {
       const name = this.labels[1] || "compare";
       for (const s of spec.series) {
         if (!s.compare || !s.compare.label) continue;
         const style = twinCompareStyle(s);
-        compares.push([`${name} ${s.compare.label}`, style.color, style.dash]);
+        compares.push([`${name} ${s.compare.label}`, style.color, style.dash, null]);
       }
-      if (!compares.length) compares.push([name, TWIN_COMPARE_TINT, [5, 3]]);
+      if (!compares.length) compares.push([name, TWIN_COMPARE_TINT, [5, 3], null]);
     }
     items.push(...compares);
     const kept = 1 + compares.length;  // the first series, and the compare entries when there are any
-    const needs = () => items.reduce((w, [label]) => w + ctx.measureText(label).width + 23, 0);
+    const needs = () => items.reduce((w, [label, , , both]) => w + ctx.measureText(label).width + 23 + (both ? 16 : 0), 0);
     for (let size = 9; size >= 8 && needs() > right - leftmost; size--) ctx.font = `${size}px sans-serif`;
     while (items.length > kept && needs() > right - leftmost) items.splice(items.length - compares.length - 1, 1);
     const drawn = [];
-    for (const [label, color, dash] of items.reverse()) {
-      if (x - ctx.measureText(label).width - 20 < leftmost) break;  // no room even for one: the title stays readable
+    this._both = [];
+    const swatch = (color, dash, at) => {
+      ctx.strokeStyle = color;
+      ctx.lineWidth = 1.6;
+      ctx.setLineDash(dash);
+      ctx.beginPath(); ctx.moveTo(at - 14, y - 3); ctx.lineTo(at, y - 3); ctx.stroke();
+      ctx.setLineDash([]);
+    };
+    for (const [label, color, dash, both] of items.reverse()) {
+      if (x - ctx.measureText(label).width - 20 - (both ? 16 : 0) < leftmost) break;  // no room even for one
       ctx.fillStyle = "#333";
       ctx.fillText(label, x, y);
       drawn.unshift(label);
       x -= ctx.measureText(label).width + 3;
-      ctx.strokeStyle = color;
-      ctx.lineWidth = 1.6;
-      ctx.setLineDash(dash);
-      ctx.beginPath(); ctx.moveTo(x - 14, y - 3); ctx.lineTo(x, y - 3); ctx.stroke();
-      ctx.setLineDash([]);
+      swatch(color, dash, x);
+      if (both) {  // the second joint's line, left of the first's
+        swatch(both.color, both.dash, x - 16);
+        this._both.unshift(label);
+        x -= 16;
+      }
       x -= 20;
     }
     ctx.font = "10px sans-serif";

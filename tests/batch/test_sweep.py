@@ -492,3 +492,23 @@ def test_ray_address_auto_with_no_cluster_leaves_nothing(tmp_path):
     assert proc.stderr.strip().splitlines()[-1].endswith("no scenario ran")
     assert "kept" not in proc.stderr.strip().splitlines()[-1]
     assert not (tmp_path / "s").exists()
+
+
+def test_the_printed_summary_keeps_its_columns_under_long_names():
+    """A probe (stop 41): a plant name over 8 characters (an ensemble member, ``as-built~10``) or a supply over
+    five pushed the rest of its line out of the header's columns. Every line's columns now end where the
+    header's do; a table of short names prints as before."""
+    from twin.batch.tables import format_summary
+
+    def group(plant, kpa):
+        return {"controller": "smc", "trajectory": 3, "payload_g": 13.5, "orientation": "vertical", "plant": plant,
+                "supply_kpa": kpa, "pwm_period_ms": 16.0, "runs": 5, "failed": 0, "rmse_mean_deg": 2.5,
+                "rmse_std_deg": 0.1, "sse_min_deg": float("nan"), "sse_max_deg": float("nan")}
+
+    lines = format_summary([group("thesis", 300.0), group("as-built~10", 1234.5), group("as-built", None)]).splitlines()
+    heads = ("T", "payload g", "orient", "plant", "kPa", "PWM ms", "runs", "fail")  # right-aligned
+    header_ends = [lines[0].index(f" {h} ") + 1 + len(h) for h in heads]
+    for line in lines[1:]:  # a row's fields hold no space up to its runs and failures
+        assert [m.end() for m in re.finditer(r"\S+", line)][1:9] == header_ends, lines
+    assert format_summary([group("thesis", 300.0)]).splitlines()[1] == (
+        "smc         3      13.5   vertical   thesis   300     16    5    0    2.50±0.10      - (ends moving)")

@@ -214,6 +214,33 @@ def test_the_environment_refuses_what_it_cannot_run_in_one_line(kwargs, message)
         joint_env.load("track", trajectory=1, **kwargs)
 
 
+@pytest.mark.parametrize("action", ["50", ["50"], [True], True, np.array([1], dtype=bool), [None], [[50.0, 20.0]]])
+def test_an_action_that_is_not_one_number_is_refused(action):
+    """A probe (stop 41): NumPy read the text "50" as 50 % and True as 1 %, and the step ran. An action is a
+    number: text, a truth value or anything else is refused in one line, naming what was given."""
+    from twin.exceptions import InvalidAction
+
+    env = joint_env.load("track", trajectory=1, seed=0)
+    env.reset()
+    with pytest.raises(InvalidAction, match="the action must be one number"):
+        env.step(action)
+
+
+@pytest.mark.parametrize("action", [50, [50], np.int64(50), np.array([50.0], dtype=np.float32), [-20.5]])
+def test_an_action_in_any_numeric_type_is_taken(action):
+    env = joint_env.load("track", trajectory=1, seed=0)
+    env.reset()
+    env.step(action)
+    assert env.physics.duty[0] == float(np.asarray(action).reshape(1)[0])
+
+
+@pytest.mark.parametrize("trajectory", [True, 1.0, "1"])
+def test_a_trajectory_that_is_not_a_whole_number_is_refused(trajectory):
+    """A probe (stop 41): ``trajectory=True`` ran T1 (True == 1)."""
+    with pytest.raises(InvalidScenario, match="unknown trajectory"):
+        joint_env.load("track", trajectory=trajectory)
+
+
 def test_the_largest_seed_the_environment_takes_runs():
     env = joint_env.load("track", trajectory=2, seed=2**32 - 1)
     assert env.reset().first()

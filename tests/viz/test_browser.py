@@ -572,7 +572,8 @@ COMPARE_B_TEAL = (11, 107, 115)  # the compare joint's chamber B (viz/strip_char
 def test_the_compare_joints_chambers_are_told_apart(tmp_path, page):
     """The second joint's chamber A and B pressures were both dashed teal, told apart only by where they ran (a
     helper in chromium, stop 40): B is now a darker teal, dash-dotted, and the legend names "compare A" and
-    "compare B"; a legend short of room still keeps them and the first series, dropping the first joint's later
+    "compare B", and (stop 42) the supply's entry shows the second joint's dotted teal line beside the first's; a
+    legend short of room still keeps the compare entries and the first series, dropping the first joint's later
     ones first."""
     html = record(tmp_path, "--controller", "ffpva", "--trajectory", "1", "--compare", "controller=smc,payload=13.5")
     open_recording(page, html)
@@ -581,6 +582,8 @@ def test_the_compare_joints_chambers_are_told_apart(tmp_path, page):
     assert chart_pixels(page, "angle", COMPARE_B_TEAL) < 5  # the darker teal is chamber B's alone
     legends = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legend])"))
     assert legends["pressure"] == ["chamber A", "chamber B", "supply", "compare A", "compare B"]
+    both = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legendBoth || []])"))
+    assert both["pressure"] == ["supply"] and not any(both[c] for c in ("angle", "error", "duty"))
     assert all(legends[chart][-1] == "compare" for chart in ("angle", "error", "duty", "valves"))
     page.set_viewport_size({"width": 800, "height": 600})  # a narrow panel: the legend gives up the first's later series
     page.wait_for_timeout(500)

@@ -39,6 +39,7 @@ from __future__ import annotations
 import collections
 import dataclasses
 import math
+import numbers
 import os
 import warnings
 
@@ -221,8 +222,11 @@ class JointTask(base.Task):
     def before_step(self, action, physics: JointPhysics) -> None:
         """The action is the duty in %: a non-finite one is refused (InvalidAction); one outside
         [-100, 100] is clipped, and the first clip of an episode is reported (a warning)."""
-        try:
-            duty = np.asarray(action, dtype=float).reshape(1)
+        try:  # a number, not text or a truth value (NumPy reads "50" as 50 and True as 1)
+            given = np.asarray(action)
+            if given.dtype.kind not in "iuf":
+                raise TypeError(given.dtype)
+            duty = given.astype(float).reshape(1)
         except (TypeError, ValueError):
             raise InvalidAction(f"the action must be one number (duty in %), got {action!r}") from None
         if not np.all(np.isfinite(duty)):
@@ -277,7 +281,8 @@ def load(task: str = "track", *, trajectory: int | None = 1, action_period: floa
     """
     if task not in TASKS:
         raise InvalidScenario(f"unknown task {task!r}: choose one of {', '.join(TASKS)}")
-    if trajectory is not None and trajectory not in (1, 2, 3, 4):
+    if trajectory is not None and (isinstance(trajectory, bool) or not isinstance(trajectory, numbers.Integral)
+                                   or trajectory not in (1, 2, 3, 4)):
         raise InvalidScenario(f"unknown trajectory {trajectory!r}: choose 1-4 or None (random)")
     randomise_load = task == "hold" and "payload" not in scenario and "orientation" not in scenario
     base_scenario = Scenario(controller, trajectory or 1, seed=seed, **scenario)
