@@ -135,37 +135,64 @@ def report(data: dict, workers: int) -> None:
           + " ".join(leads))
 
 
-def main(argv: list[str] | None = None) -> None:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--start", type=float, help="where T1, T2 and T4 start, deg (none: the unrefitted table)")
+def checked_file(parser: argparse.ArgumentParser, path: pathlib.Path, setting: str) -> dict:
+    """The calibration file ``path``, refused (a parser error) unless its ``code_version`` shows it was fitted with
+    the presets, trajectories and MJCF in force (inside the block that sets the trial's condition, ``setting``)."""
+    data = json.loads(path.read_text())
+    if params_hash(data["code_version"]) != params_hash(code_version(plants=calibrate.fit_presets(data["fitted"]))):
+        parser.error(f"{path} was not fitted {setting} with these presets, trajectories and MJCF "
+                     "(they hash to another value)")
+    return data
+
+
+def fitted_or_read(parser: argparse.ArgumentParser, args: argparse.Namespace, setting: str, name: str) -> dict:
+    """Inside the block that sets a trial's condition (``setting``, as "from 20 deg"): the file
+    ``args.calibration``, once its ``code_version`` shows it was fitted so and its measured cells run again
+    (:func:`recomputed`); otherwise a fresh fit, written as ``name`` in ``args.out`` when given."""
+    if args.calibration:
+        data = checked_file(parser, args.calibration, setting)
+        recomputed(data, args.workers)
+        return data
+    result = fit(args.workers)
+    data = calibrate.record(result)
+    print(f"the fit: {result.wall_time:.0f} s")
+    if args.out:
+        args.out.mkdir(parents=True, exist_ok=True)
+        print(f"wrote {calibrate.write(data, args.out, name)}")
+    return data
+
+
+
+def refit_arguments(doc: str, flag: str, help: str, folder: str, argv: list[str] | None,
+                    extra=None) -> tuple[argparse.ArgumentParser, argparse.Namespace]:
+    """A refit trial's command line: ``--FLAG`` (a number: the trial's condition; none: its unrefitted table),
+    ``--out``, ``--calibration`` (a file written before in ``folder``, at the same condition) and ``--workers``;
+    ``extra(parser)`` adds a trial's own."""
+    parser = argparse.ArgumentParser(description=doc.splitlines()[0])
+    parser.add_argument(f"--{flag}", type=float, help=help)
     parser.add_argument("--out", type=pathlib.Path, help="write the trial's calibration file here")
     parser.add_argument("--calibration", type=pathlib.Path, help="skip the fit: report a trial calibration file "
-                        "written before at the same start (examples/trial_start_refit/)")
+                        f"written before at the same {flag} ({folder})")
     parser.add_argument("--workers", type=int, default=2)
+    if extra is not None:
+        extra(parser)
     args = parser.parse_args(argv)
     if args.calibration and args.out:
         parser.error("--calibration reports a file written before; it writes nothing (no --out)")
+    if getattr(args, flag) is None and (args.calibration or args.out):
+        parser.error(f"--calibration and --out need --{flag}")
+    return parser, args
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser, args = refit_arguments(__doc__, "start", "where T1, T2 and T4 start, deg (none: the unrefitted table)",
+                                   "examples/trial_start_refit/", argv)
     if args.start is None:
-        if args.calibration or args.out:
-            parser.error("--calibration and --out need --start")
         unfitted()
         return
     print(f"T1, T2 and T4 from {args.start:g} deg (committed: {COMMITTED_START_DEG:g})")
     with started_at(args.start):
-        if args.calibration:
-            data = json.loads(args.calibration.read_text())
-            if params_hash(data["code_version"]) != params_hash(code_version(plants=calibrate.fit_presets(data["fitted"]))):
-                parser.error(f"{args.calibration} was not fitted from {args.start:g} deg with these presets, "
-                             "trajectories and MJCF (they hash to another value)")
-            recomputed(data, args.workers)
-        else:
-            result = fit(args.workers)
-            data = calibrate.record(result)
-            print(f"the fit: {result.wall_time:.0f} s")
-            if args.out:
-                args.out.mkdir(parents=True, exist_ok=True)
-                print(f"wrote {calibrate.write(data, args.out, f'start_{args.start:g}.json')}")
-        report(data, args.workers)
+        report(fitted_or_read(parser, args, f"from {args.start:g} deg", f"start_{args.start:g}.json"), args.workers)
 
 
 if __name__ == "__main__":

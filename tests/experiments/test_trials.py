@@ -327,6 +327,127 @@ def test_trial_start_refit_reports_what_prediction_md_quotes(capsys):
     }
 
 
+@pytest.mark.slow  # about 2 min on 2 cores: the committed preset's cost from five start pressures; 21 cells and T3 on four files
+def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
+    """The committed preset's cost with the chambers starting at five fractions of the supply, nothing refitted, and
+    the kept trial calibrations (fitted with the chambers at 0, 0.25, 0.75 and 1.0 of the supply on 2026-11-28),
+    reported again, give what the fits printed and docs/prediction.md and docs/investigations.md quote: the measured
+    cells run again at each file's fraction give the file's own table (so the fraction reaches the forked workers),
+    then the steady-error ranges within and the T3 cells on every member. At 0.5 the cost is the committed file's.
+    A file is refused at a fraction it was not fitted at; the trial puts the committed chambers back."""
+    from twin.plants import as_built
+
+    trial, folder, committed = (_load("trial_start_pressure_refit"), ROOT / "examples" / "trial_start_pressure_refit",
+                                as_built.ChamberParams)
+    trial.main([])  # the committed preset's cost from five start pressures, nothing refitted
+    assert capsys.readouterr().out.splitlines() == [
+        "the committed preset, nothing refitted, cost on the fit's seeds 0-9 (the file's: 0.5367)",
+        'chambers from 0 of the supply: cost 0.5918',
+        'chambers from 0.25 of the supply: cost 0.6383',
+        'chambers from 0.5 of the supply: cost 0.5367',
+        'chambers from 0.75 of the supply: cost 0.6296',
+        'chambers from 1 of the supply: cost 0.6795',
+    ]
+    printed = {}
+    for fraction in ("0", "0.25", "0.75", "1"):
+        trial.main(["--fraction", fraction, "--calibration", str(folder / f"fraction_{fraction}.json")])
+        printed[fraction] = capsys.readouterr().out.splitlines()
+    assert as_built.ChamberParams is committed
+    with pytest.raises(SystemExit):
+        trial.main(["--fraction", "0.5", "--calibration", str(folder / "fraction_0.json")])
+    assert "was not fitted with the chambers at 0.5 of the supply with these presets" in capsys.readouterr().err
+    assert printed == {
+        "0": [
+            'both chambers start at 0 of the supply (committed: 0.5)',
+            "the measured cells run again from this start: 17 of 21 within 20 %, each mean as the file's: True",
+            'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 11 of 13',
+            'fitted: stiction 1.844, air_fraction 0.04277, ccw_coulomb_scale 1.144, leak_conductance 1.604e-14, load_friction 0.3, observer_gain 480.1',
+            'cost 0.5788, noise 0.1439; 67 evaluations; 11 members',
+            'measured cells within 20 % on seeds 0-4 (best): 17 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.30  2.28-2.44  2.13-2.47  0',
+            '  ffpva   6.5 g horizontal 2.58  2.55-2.64  2.34-2.74  0',
+            '  ffpva  13.5 g horizontal 2.91  2.82-2.94  2.64-3.07  0',
+            '  ffpva     0 g vertical   2.31  2.24-2.43  2.14-2.50  0',
+            '  ffpva   6.5 g vertical   2.62  2.44-2.63  2.37-2.75  0',
+            '  ffpva  13.5 g vertical   3.72  3.64-3.86  3.53-4.80  0',
+            '  smc       0 g horizontal 2.21  2.21-2.29  2.19-2.30  0',
+            '  smc     6.5 g horizontal 2.40  2.38-2.48  2.37-2.56  0',
+            '  smc    13.5 g horizontal 2.66  2.54-2.66  2.52-2.73  0',
+            '  smc       0 g vertical   2.24  2.21-2.27  2.21-2.28  0',
+            '  smc     6.5 g vertical   2.38  2.38-2.50  2.37-2.58  0',
+            '  smc    13.5 g vertical   3.32  3.32-3.50  3.31-4.42  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS FFFFFS SSSSSS SSSFSS SSSSSS SSSSSS FSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+        ],
+        "0.25": [
+            'both chambers start at 0.25 of the supply (committed: 0.5)',
+            "the measured cells run again from this start: 16 of 21 within 20 %, each mean as the file's: True",
+            'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 11 of 13',
+            'fitted: stiction 1.395, air_fraction 0.052, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515',
+            'cost 0.5843, noise 0.1412; 63 evaluations; 11 members',
+            'measured cells within 20 % on seeds 0-4 (best): 16 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.39  2.30-2.43  2.18-2.44  0',
+            '  ffpva   6.5 g horizontal 2.66  2.51-2.71  2.51-2.79  0',
+            '  ffpva  13.5 g horizontal 2.99  2.81-3.02  2.74-3.03  0',
+            '  ffpva     0 g vertical   2.33  2.27-2.41  2.19-2.47  0',
+            '  ffpva   6.5 g vertical   2.74  2.58-2.79  2.55-2.82  0',
+            '  ffpva  13.5 g vertical   3.74  3.56-3.81  3.53-4.90  0',
+            '  smc       0 g horizontal 2.19  2.15-2.25  2.07-2.28  0',
+            '  smc     6.5 g horizontal 2.41  2.36-2.44  2.35-2.50  0',
+            '  smc    13.5 g horizontal 2.63  2.56-2.62  2.55-2.63  0',
+            '  smc       0 g vertical   2.22  2.14-2.23  2.09-2.30  0',
+            '  smc     6.5 g vertical   2.44  2.40-2.48  2.37-2.50  0',
+            '  smc    13.5 g vertical   3.41  3.35-3.44  3.34-4.34  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+        ],
+        "0.75": [
+            'both chambers start at 0.75 of the supply (committed: 0.5)',
+            "the measured cells run again from this start: 17 of 21 within 20 %, each mean as the file's: True",
+            'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 8 of 13',
+            'fitted: stiction 1.789, air_fraction 0.04, ccw_coulomb_scale 1, leak_conductance 1.725e-14, load_friction 0.3, observer_gain 515',
+            'cost 0.5633, noise 0.0924; 63 evaluations; 11 members',
+            'measured cells within 20 % on seeds 0-4 (best): 17 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.39  2.35-2.44  2.32-2.45  0',
+            '  ffpva   6.5 g horizontal 2.58  2.55-2.73  2.55-2.73  0',
+            '  ffpva  13.5 g horizontal 2.76  2.77-2.88  2.76-2.99  0',
+            '  ffpva     0 g vertical   2.43  2.36-2.45  2.33-2.51  0',
+            '  ffpva   6.5 g vertical   2.57  2.54-2.63  2.51-2.68  0',
+            '  ffpva  13.5 g vertical   3.62  3.58-3.77  3.56-3.79  0',
+            '  smc       0 g horizontal 2.22  2.21-2.27  2.18-2.27  0',
+            '  smc     6.5 g horizontal 2.42  2.33-2.42  2.32-2.42  0',
+            '  smc    13.5 g horizontal 2.57  2.58-2.67  2.57-2.68  0',
+            '  smc       0 g vertical   2.27  2.18-2.26  2.16-2.27  0',
+            '  smc     6.5 g vertical   2.41  2.41-2.47  2.40-2.51  0',
+            '  smc    13.5 g vertical   3.41  3.40-3.49  3.38-3.64  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+        ],
+        "1": [
+            'both chambers start at 1 of the supply (committed: 0.5)',
+            "the measured cells run again from this start: 16 of 21 within 20 %, each mean as the file's: True",
+            'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 11 of 13',
+            'fitted: stiction 1.587, air_fraction 0.04573, ccw_coulomb_scale 1.145, leak_conductance 1.715e-14, load_friction 0.15, observer_gain 499.5',
+            'cost 0.5341, noise 0.1359; 67 evaluations; 11 members',
+            'measured cells within 20 % on seeds 0-4 (best): 16 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.24  2.24-2.37  2.11-2.39  0',
+            '  ffpva   6.5 g horizontal 2.63  2.58-2.69  2.44-2.83  0',
+            '  ffpva  13.5 g horizontal 2.90  2.86-3.00  2.60-3.01  0',
+            '  ffpva     0 g vertical   2.32  2.32-2.40  2.15-2.44  0',
+            '  ffpva   6.5 g vertical   2.70  2.62-2.75  2.47-2.78  0',
+            '  ffpva  13.5 g vertical   3.37  3.32-3.81  3.28-4.87  0',
+            '  smc       0 g horizontal 2.23  2.19-2.25  2.18-2.26  0',
+            '  smc     6.5 g horizontal 2.42  2.37-2.44  2.33-2.54  0',
+            '  smc    13.5 g horizontal 2.62  2.56-2.62  2.54-2.73  0',
+            '  smc       0 g vertical   2.22  2.21-2.29  2.20-2.29  0',
+            '  smc     6.5 g vertical   2.43  2.39-2.49  2.35-2.60  0',
+            '  smc    13.5 g vertical   2.97  2.90-3.55  2.89-4.32  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS FFFFFS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+        ],
+    }
+
+
 @pytest.mark.slow  # about 1 min: §8's eleven cells, ten seeds, nine ways (the plain runs and eight delays)
 def test_trial_actuation_delay_prints_what_as_built_md_quotes(capsys):
     from twin.physics.valves import ValveBank

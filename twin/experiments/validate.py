@@ -111,14 +111,17 @@ def _t3_as_run_text() -> str:
     return (f"T3 as the twin runs it: {math.degrees(t3.start):g} ± {math.degrees(sine.delta):g} deg at 0.5 Hz for "
             f"{t3.duration:g} s, starting mid-stroke at full speed (the thesis simulated its largest error at T3's start), "
             f"at a supply of {params.supply.pressure / 1e3:g} kPa{chapter5}; the committed preset was fitted on the "
-            f"measured cells with T1, T2 and T4 run from {math.degrees(t1.start):g} deg. The thesis states neither T3's length nor its start "
-            "nor where T1, T2 and T4 started, nor restates the supply for Chapter 6, and the band does not include the "
-            "uncertainty of any of them: it is the spread over the fitted parameters with these held. "
-            "docs/prediction.md in the repository records a trial of each (`examples/trial_t2_t3_choices.py`, "
-            "`examples/trial_chapter6_supply.py`, `examples/trial_start_refit.py`); the 13.5 g vertical cells depend "
-            "on them most. On the tenth refit (committed 2026-11-27), refitted about as well with T1, T2 and T4 from "
-            "20 deg, those two cells came out 4.84 and 4.28 deg (FF + PVA, sliding mode), above that preset's band "
-            "(whose tops were 3.81 and 3.48).")
+            f"measured cells with T1, T2 and T4 run from {math.degrees(t1.start):g} deg and both chambers starting at "
+            f"{params.chambers.initial_pressure_fraction:g} of the supply. The thesis states neither T3's length nor "
+            "its start nor where T1, T2 and T4 started nor what the chambers held when a run began, nor restates the "
+            "supply for Chapter 6, and the band does not include the uncertainty of any of them: it is the spread over "
+            "the fitted parameters with these held. docs/prediction.md in the repository records a trial of each "
+            "(`examples/trial_t2_t3_choices.py`, `examples/trial_start_refit.py`, "
+            "`examples/trial_start_pressure_refit.py`, `examples/trial_chapter6_supply.py`); the 13.5 g vertical "
+            "cells depend on them most. On the tenth refit (committed 2026-11-27), refitted about as well with T1, T2 "
+            "and T4 from 20 deg, those two cells came out 4.84 and 4.28 deg (FF + PVA, sliding mode), above that "
+            "preset's band (whose tops were 3.81 and 3.48); refitted about as well with the chambers starting at the "
+            "supply's pressure, 3.37 and 2.97 deg, below it (whose bottoms were 3.62 and 3.38).")
 
 
 def _fixed_text(members: Sequence[dict]) -> str:
@@ -1691,8 +1694,8 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
                      + ("No run of any ensemble member stalls." if not stalls else
                         f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}.")
                      + " The band is the spread over the fitted parameters only, not over the choices the thesis "
-                       "leaves open (T3's length and start, the supply, where T1, T2 and T4 started), which the "
-                       "prediction section names.")
+                       "leaves open (T3's length and start, the supply, where T1, T2 and T4 started, what the chambers "
+                       "held when a run began), which the prediction section names.")
     return lines
 
 
