@@ -14,7 +14,7 @@ its 0.537 and its seed-to-seed noise 0.139. Fractions tried: 0 (relaxed: the tan
 (the supply's), chosen before any of these fits ran.
 
 Run without ``--fraction``, it prints the committed preset's cost on the fit's seeds with the chambers starting at
-each fraction, nothing refitted (about 1 min). With ``--fraction`` it fits (5-7 min on 2 cores), prints the fitted
+each fraction, nothing refitted (about 1 min). With ``--fraction`` it fits (5-8 min on 2 cores), prints the fitted
 values, the cost and its noise, the members, the measured cells and T1 steady-error ranges within the issue's bars
 on seeds 0-4 (best), then each T3 cell's value on the best, its band and the members' range, the stalled runs,
 and per member which law leads in each cell (``examples/trial_start_refit.py``'s report). ``--out DIR`` also writes
@@ -24,8 +24,9 @@ fraction, and first runs the measured cells again on its best values to show the
 ``--validate DIR`` as well it runs ``twin validate --out DIR`` on that file, the chambers starting at that fraction,
 instead (1-2 min; ``examples/trial_air_box.py``'s way of putting a trial file in place of the committed preset). The
 files of 2026-11-28 are in ``examples/trial_start_pressure_refit/``. Nothing is installed, and the T3 cells'
-measurements were not seen. The result is recorded in docs/investigations.md; a slow test in
-tests/experiments/test_trials.py holds the printed numbers of the kept files.
+measurements were not seen. The result is recorded in docs/investigations.md and docs/prediction.md; a slow test in
+tests/experiments/test_trials.py holds the printed numbers of the kept files. (Their ``assumed`` entry for the start
+pressure was corrected after the fits, on a review: the fits had recorded the committed "half the supply".)
 
     python examples/trial_start_pressure_refit.py
     python examples/trial_start_pressure_refit.py --fraction F [--out DIR] [--workers N]
@@ -57,13 +58,22 @@ FRACTIONS = (0.0, 0.25, 0.5, 0.75, 1.0)  # of the supply (gauge), in both chambe
 @contextlib.contextmanager
 def chambers_starting_at(fraction: float):
     """Every as-built plant built inside the block (and in every process forked in it) starts its chambers at
-    ``fraction`` of the supply; after it, at the committed fraction."""
-    committed = as_built.ChamberParams
+    ``fraction`` of the supply, and a calibration file written in it says so (its ``assumed`` entry); after it, the
+    committed fraction and text."""
+    committed, said = as_built.ChamberParams, as_built.ASSUMED["initial_pressure_fraction"]
     as_built.ChamberParams = functools.partial(ChamberParams, initial_pressure_fraction=fraction)
+    as_built.ASSUMED["initial_pressure_fraction"] = assumed_text(fraction)  # the dict calibrate.record copies
     try:
         yield
     finally:
         as_built.ChamberParams = committed
+        as_built.ASSUMED["initial_pressure_fraction"] = said
+
+
+def assumed_text(fraction: float) -> str:
+    """What a trial calibration file fitted at ``fraction`` says of the chambers' start."""
+    return (f"both chambers start at {fraction:g} of the supply (a trial, examples/trial_start_pressure_refit.py; the "
+            "committed preset assumes half)")
 
 
 def unfitted(workers: int) -> None:

@@ -162,7 +162,6 @@ def fitted_or_read(parser: argparse.ArgumentParser, args: argparse.Namespace, se
     return data
 
 
-
 def refit_arguments(doc: str, flag: str, help: str, folder: str, argv: list[str] | None,
                     extra=None) -> tuple[argparse.ArgumentParser, argparse.Namespace]:
     """A refit trial's command line: ``--FLAG`` (a number: the trial's condition; none: its unrefitted table),

@@ -255,6 +255,7 @@ class StripCharts {
       chart.legend = this._legend(ctx, spec, traces.length, left + width, 11,
                                   left + ctx.measureText(spec.title + " (" + spec.unit + ")").width + 8);
       chart.legendBoth = this._both;
+      chart.legendSwatches = this._swatches;
     }
     if (this.selection) {  // a drag under way: the span it will zoom to
       const [a, b] = this.selection.map((t) => Math.min(Math.max(xOf(t), left), left + width));
@@ -277,7 +278,8 @@ class StripCharts {
   // the compare joint's entries: "compare" on both pages, the page's title and info say what it is, or one per
   // series the second joint draws its own way, "compare A" and "compare B"). A series marked ``compare.both``
   // (the supply) takes no entry of its own for the second joint: its entry shows the second joint's line beside
-  // the first's. Returns the names drawn; ``this._both`` the names drawn with both lines.
+  // the first's, unless the legend is short of room, when it shows the first's alone before any entry is
+  // dropped. Returns the names drawn; ``this._both`` the names drawn with both lines.
   _legend(ctx, spec, count, right, y, leftmost = 0) {
     ctx.textAlign = "right";
     ctx.textBaseline = "alphabetic";
@@ -301,10 +303,13 @@ class StripCharts {
     const kept = 1 + compares.length;  // the first series, and the compare entries when there are any
     const needs = () => items.reduce((w, [label, , , both]) => w + ctx.measureText(label).width + 23 + (both ? 16 : 0), 0);
     for (let size = 9; size >= 8 && needs() > right - leftmost; size--) ctx.font = `${size}px sans-serif`;
+    for (const item of items) if (needs() > right - leftmost) item[3] = null;  // short of room: one line per entry
     while (items.length > kept && needs() > right - leftmost) items.splice(items.length - compares.length - 1, 1);
     const drawn = [];
     this._both = [];
-    const swatch = (color, dash, at) => {
+    this._swatches = [];  // [label, colour, left x, right x, y] of each swatch drawn (CSS px)
+    const swatch = (color, dash, at, label) => {
+      this._swatches.push([label, color, at - 14, at, y - 3]);
       ctx.strokeStyle = color;
       ctx.lineWidth = 1.6;
       ctx.setLineDash(dash);
@@ -317,9 +322,9 @@ class StripCharts {
       ctx.fillText(label, x, y);
       drawn.unshift(label);
       x -= ctx.measureText(label).width + 3;
-      swatch(color, dash, x);
+      swatch(color, dash, x, label);
       if (both) {  // the second joint's line, left of the first's
-        swatch(both.color, both.dash, x - 16);
+        swatch(both.color, both.dash, x - 16, label);
         this._both.unshift(label);
         x -= 16;
       }

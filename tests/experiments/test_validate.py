@@ -189,10 +189,12 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
     assert ("T3 as the twin runs it: 80 ± 60 deg at 0.5 Hz for 4 s, starting mid-stroke at full speed" in section
             and "at a supply of 300 kPa, Chapter 5's;" in section
             and "the band does not include the uncertainty of any of them" in section)
-    assert "fitted on the measured cells with T1, T2 and T4 run from 30 deg" in section
+    assert ("fitted on the measured cells with T1, T2 and T4 run from 30 deg and both chambers starting at 50 % of "
+            "the supply" in section and "nor what the chambers held when a run began" in section)
     opening = text[text.index("## In short"):text.index("## Summary")]
     assert "- **Blind T3 prediction**" in opening and "not over the choices the thesis leaves open" in opening
-    for trial in ("trial_t2_t3_choices", "trial_chapter6_supply", "trial_start_refit"):
+    assert "where T1, T2 and T4 started, what the chambers held when a run began)" in opening
+    for trial in ("trial_t2_t3_choices", "trial_chapter6_supply", "trial_start_refit", "trial_start_pressure_refit"):
         assert f"`examples/{trial}.py`" in section
         assert (pathlib.Path(__file__).resolve().parents[2] / "examples" / f"{trial}.py").is_file()
     committed, preset = trajectories.trajectory, twin.plants.plant
@@ -207,14 +209,15 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
     def lower(name):
         p = preset(name)
         supply = dataclasses.replace(p.params.supply, pressure=250e3)
-        return dataclasses.replace(p, params=dataclasses.replace(p.params, supply=supply))
+        chambers = dataclasses.replace(p.params.chambers, initial_pressure_fraction=0.25)
+        return dataclasses.replace(p, params=dataclasses.replace(p.params, supply=supply, chambers=chambers))
 
     monkeypatch.setattr(trajectories, "trajectory", longer)
     monkeypatch.setattr(trajectories, "START", math.radians(40.0))
     monkeypatch.setattr(twin.plants, "plant", lower)
     other = validate.report(_fake(1.0, True, 0))
     assert "T3 as the twin runs it: 70 ± 60 deg at 0.5 Hz for 6 s" in other and "at a supply of 250 kPa;" in other
-    assert "with T1, T2 and T4 run from 40 deg" in other
+    assert "with T1, T2 and T4 run from 40 deg and both chambers starting at 25 % of the supply" in other
 
 
 def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_says():

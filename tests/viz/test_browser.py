@@ -584,6 +584,21 @@ def test_the_compare_joints_chambers_are_told_apart(tmp_path, page):
     assert legends["pressure"] == ["chamber A", "chamber B", "supply", "compare A", "compare B"]
     both = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legendBoth || []])"))
     assert both["pressure"] == ["supply"] and not any(both[c] for c in ("angle", "error", "duty"))
+    teal_in_swatch = page.evaluate("""(() => {  // teal pixels along the supply entry's second swatch
+        const chart = window.twinPlots.charts.find((c) => c.spec.id === 'pressure'), c = chart.canvas;
+        const ratio = c.width / c.clientWidth;
+        const [, , x0, x1, y] = chart.legendSwatches.filter((s) => s[0] === 'supply')[1];
+        const d = c.getContext('2d').getImageData(Math.floor(x0 * ratio), Math.floor((y - 1) * ratio),
+                                                   Math.ceil((x1 - x0) * ratio), Math.ceil(2 * ratio)).data;
+        let n = 0;
+        for (let i = 0; i < d.length; i += 4) if (d[i] < 90 && d[i + 1] > 120 && d[i + 2] > 130) n++;
+        return n;
+    })()""")
+    assert teal_in_swatch > 0  # the second joint's dotted teal, drawn
+    page.set_viewport_size({"width": 1100, "height": 720})  # short of room: the supply's entry shows one line
+    page.wait_for_timeout(500)                                  # rather than go (a review's width, stop 42)
+    shown = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legend])"))["pressure"]
+    assert "supply" in shown, shown
     assert all(legends[chart][-1] == "compare" for chart in ("angle", "error", "duty", "valves"))
     page.set_viewport_size({"width": 800, "height": 600})  # a narrow panel: the legend gives up the first's later series
     page.wait_for_timeout(500)

@@ -38,6 +38,7 @@ from __future__ import annotations
 
 import collections
 import dataclasses
+import decimal
 import math
 import numbers
 import os
@@ -224,6 +225,8 @@ class JointTask(base.Task):
         [-100, 100] is clipped, and the first clip of an episode is reported (a warning)."""
         try:  # a number, not text or a truth value (NumPy reads "50" as 50 and True as 1)
             given = np.asarray(action)
+            if given.dtype.kind == "O" and all(_a_number(x) for x in given.flat):
+                given = given.astype(float)  # Decimal, Fraction, an int past int64
             if given.dtype.kind not in "iuf":
                 raise TypeError(given.dtype)
             duty = given.astype(float).reshape(1)
@@ -261,6 +264,11 @@ class JointTask(base.Task):
     def get_reward(self, physics: JointPhysics) -> float:
         error_deg = math.degrees(physics.angle_error())
         return float(math.exp(-0.5 * error_deg**2))
+
+
+def _a_number(x: object) -> bool:
+    """A real number of any type (a Python or NumPy one, a Decimal, a Fraction), not a truth value."""
+    return isinstance(x, numbers.Real | decimal.Decimal) and not isinstance(x, bool | np.bool_)
 
 
 def episode_steps(duration: float, action_period: float) -> int:

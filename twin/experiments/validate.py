@@ -98,7 +98,8 @@ def _t3_as_run_text() -> str:
     restate for Chapter 6) and where the fitted cells' T1, T2 and T4 start, and where to read how much they
     matter. The start is ``trajectories.START`` as the report runs: the committed calibration was fitted with it,
     since its ``code_version`` (which hashes the trajectories) is the sweep store's. The trial's numbers are the
-    tenth refit's and said as such. Added 2026-11-27 (stop 38), after the trials it points to."""
+    tenth refit's and said as such. Added 2026-11-27 (stop 38), after the trials it points to; the chambers' start
+    pressure (the as-built plant's, an assumption) and its trial added 2026-11-28 (stop 42), after that trial."""
     from twin.physics.params import NOMINAL_PARAMS
     from twin.physics.trajectories import trajectory
     from twin.plants import plant
@@ -112,7 +113,7 @@ def _t3_as_run_text() -> str:
             f"{t3.duration:g} s, starting mid-stroke at full speed (the thesis simulated its largest error at T3's start), "
             f"at a supply of {params.supply.pressure / 1e3:g} kPa{chapter5}; the committed preset was fitted on the "
             f"measured cells with T1, T2 and T4 run from {math.degrees(t1.start):g} deg and both chambers starting at "
-            f"{params.chambers.initial_pressure_fraction:g} of the supply. The thesis states neither T3's length nor "
+            f"{params.chambers.initial_pressure_fraction * 100:g} % of the supply. The thesis states neither T3's length nor "
             "its start nor where T1, T2 and T4 started nor what the chambers held when a run began, nor restates the "
             "supply for Chapter 6, and the band does not include the uncertainty of any of them: it is the spread over "
             "the fitted parameters with these held. docs/prediction.md in the repository records a trial of each "
