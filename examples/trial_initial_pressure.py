@@ -35,7 +35,7 @@ import numpy as np
 
 from twin.envs.runner import thesis_controllers
 from twin.experiments.calibrate import TARGETS
-from twin.experiments.validate import PREDICTION_CELLS, SSE_TOLERANCE_DEG, rmse_within
+from twin.experiments.validate import PREDICTION_CELLS, rmse_within, sse_within
 from twin.physics.model import Orientation
 from twin.physics.trajectories import Segment, Trajectory
 from twin.plants.as_built import as_built_plant, preset_digest
@@ -139,7 +139,7 @@ def main(fresh: bool = False) -> None:
     variants += [(f"held {h:g} s at the start angle first", None, h) for h in HELD]
     for name, fraction, held in variants:
         results = committed if (fraction == 0.5 and not held) else cells(fraction, seeds, held=held)
-        within = sse_within = sse_cells = 0
+        within = ends_within = sse_cells = 0
         parts = []
         for target, (rmse, sse) in zip(TARGETS, results, strict=True):
             mean = float(np.mean(rmse))
@@ -148,10 +148,10 @@ def main(fresh: bool = False) -> None:
             if target.sse_range_deg is not None:
                 sse_cells += 1
                 twin = sse_range(sse)
-                sse_within += abs(twin - target.sse_range_deg) <= SSE_TOLERANCE_DEG
+                ends_within += sse_within(twin, target.sse_range_deg)
                 part += f" (±{twin:.2f})"
             parts.append(part)
-        print(f"{name}: within 20 % {within} of {len(TARGETS)}, SSE ranges within {sse_within} of {sse_cells} | "
+        print(f"{name}: within 20 % {within} of {len(TARGETS)}, SSE ranges within {ends_within} of {sse_cells} | "
               + " | ".join(parts), flush=True)
     if fresh:
         return

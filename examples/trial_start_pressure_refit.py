@@ -43,7 +43,7 @@ import pathlib
 import sys
 
 from twin.experiments import calibrate
-from twin.experiments.validate import SSE_TOLERANCE_DEG
+from twin.experiments.validate import SSE_TOLERANCE_DEG, sse_within
 from twin.physics.params import ChamberParams
 from twin.plants import as_built
 
@@ -90,8 +90,8 @@ def unfitted(workers: int) -> None:
 def ends(data: dict) -> None:
     """How many of the file's T1 steady-error ranges on its check seeds (best values) are within the issue's bar."""
     rows = [r for r in data["residuals_check_seeds"] if r["experiment_sse_range_deg"] is not None]
-    within = sum(r["twin_sse_range_deg"] is not None
-                 and abs(r["twin_sse_range_deg"] - r["experiment_sse_range_deg"]) <= SSE_TOLERANCE_DEG for r in rows)
+    within = sum(r["twin_sse_range_deg"] is not None and sse_within(r["twin_sse_range_deg"], r["experiment_sse_range_deg"])
+                 for r in rows)
     print(f"T1 steady-error ranges within ±{SSE_TOLERANCE_DEG:g} deg on seeds {data['check_seeds'][0]}-"
           f"{data['check_seeds'][-1]} (best): {within} of {len(rows)}")
 

@@ -252,10 +252,10 @@ class StripCharts {
       });
       ctx.setLineDash([]);
       ctx.restore();
+      chart.legendSwatches = [];
       chart.legend = this._legend(ctx, spec, traces.length, left + width, 11,
-                                  left + ctx.measureText(spec.title + " (" + spec.unit + ")").width + 8);
-      chart.legendBoth = this._both;
-      chart.legendSwatches = this._swatches;
+                                  left + ctx.measureText(spec.title + " (" + spec.unit + ")").width + 8,
+                                  chart.legendSwatches);
     }
     if (this.selection) {  // a drag under way: the span it will zoom to
       const [a, b] = this.selection.map((t) => Math.min(Math.max(xOf(t), left), left + width));
@@ -279,8 +279,9 @@ class StripCharts {
   // series the second joint draws its own way, "compare A" and "compare B"). A series marked ``compare.both``
   // (the supply) takes no entry of its own for the second joint: its entry shows the second joint's line beside
   // the first's, unless the legend is short of room, when it shows the first's alone before any entry is
-  // dropped. Returns the names drawn; ``this._both`` the names drawn with both lines.
-  _legend(ctx, spec, count, right, y, leftmost = 0) {
+  // dropped. Returns the names drawn; ``swatches`` gets [label, colour, left x, right x, y] of each line drawn
+  // (CSS px; a name drawn with both lines has two).
+  _legend(ctx, spec, count, right, y, leftmost = 0, swatches = []) {
     ctx.textAlign = "right";
     ctx.textBaseline = "alphabetic";
     let x = right;
@@ -306,10 +307,8 @@ class StripCharts {
     for (const item of items) if (needs() > right - leftmost) item[3] = null;  // short of room: one line per entry
     while (items.length > kept && needs() > right - leftmost) items.splice(items.length - compares.length - 1, 1);
     const drawn = [];
-    this._both = [];
-    this._swatches = [];  // [label, colour, left x, right x, y] of each swatch drawn (CSS px)
     const swatch = (color, dash, at, label) => {
-      this._swatches.push([label, color, at - 14, at, y - 3]);
+      swatches.push([label, color, at - 14, at, y - 3]);
       ctx.strokeStyle = color;
       ctx.lineWidth = 1.6;
       ctx.setLineDash(dash);
@@ -325,7 +324,6 @@ class StripCharts {
       swatch(color, dash, x, label);
       if (both) {  // the second joint's line, left of the first's
         swatch(both.color, both.dash, x - 16, label);
-        this._both.unshift(label);
         x -= 16;
       }
       x -= 20;

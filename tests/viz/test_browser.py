@@ -582,7 +582,9 @@ def test_the_compare_joints_chambers_are_told_apart(tmp_path, page):
     assert chart_pixels(page, "angle", COMPARE_B_TEAL) < 5  # the darker teal is chamber B's alone
     legends = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legend])"))
     assert legends["pressure"] == ["chamber A", "chamber B", "supply", "compare A", "compare B"]
-    both = dict(page.evaluate("window.twinPlots.charts.map((c) => [c.spec.id, c.legendBoth || []])"))
+    both = dict(page.evaluate("""window.twinPlots.charts.map((c) => [c.spec.id,  // names drawn with two lines
+        [...new Set((c.legendSwatches || []).map((s) => s[0]))].filter(
+            (name) => c.legendSwatches.filter((s) => s[0] === name).length === 2)])"""))
     assert both["pressure"] == ["supply"] and not any(both[c] for c in ("angle", "error", "duty"))
     teal_in_swatch = page.evaluate("""(() => {  // teal pixels along the supply entry's second swatch
         const chart = window.twinPlots.charts.find((c) => c.spec.id === 'pressure'), c = chart.canvas;

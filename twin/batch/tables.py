@@ -92,17 +92,17 @@ def format_summary(summary: Sequence[dict], limit: int = 40) -> str:
     shown = summary[:limit]
     kpa = ["-" if s["supply_kpa"] is None else format(s["supply_kpa"], "g") for s in shown]
     pwm = ["-" if s["pwm_period_ms"] is None else format(s["pwm_period_ms"], "g") for s in shown]
-    # the free-text columns as wide as their longest entry, so a long plant name keeps the columns aligned
-    wp, wk, wm = (max([len(head), *map(len, column)]) for head, column in
-                  (("plant", [s["plant"] for s in shown]), ("kPa", kpa), ("PWM ms", pwm)))
-    lines = [f"{'controller':10} {'T':>2} {'payload g':>9} {'orient':>10} {'plant':>{max(wp, 8)}} {'kPa':>{max(wk, 5)}} "
+    # the free-text columns at least as wide as before and as their longest entry (a long plant name, a supply)
+    wp, wk, wm = (max([least, *map(len, column)]) for least, column in
+                  ((8, [s["plant"] for s in shown]), (5, kpa), (6, pwm)))
+    lines = [f"{'controller':10} {'T':>2} {'payload g':>9} {'orient':>10} {'plant':>{wp}} {'kPa':>{wk}} "
              f"{'PWM ms':>{wm}} {'runs':>4} {'fail':>4} {'RMSE mean±std':>14} {'SSE range':>16}"]
     for s, k, m in zip(shown, kpa, pwm, strict=True):
         sse_range = ("   - (ends moving)" if math.isnan(s["sse_min_deg"])
                      else f"[{signed(s['sse_min_deg'], 6)},{signed(s['sse_max_deg'], 6)}]")
         lines.append(
             f"{s['controller']:10} {s['trajectory']:>2} {s['payload_g']:>9g} {s['orientation']:>10} "
-            f"{s['plant']:>{max(wp, 8)}} {k:>{max(wk, 5)}} {m:>{wm}} {s['runs']:>4} {s['failed']:>4} "
+            f"{s['plant']:>{wp}} {k:>{wk}} {m:>{wm}} {s['runs']:>4} {s['failed']:>4} "
             f"{s['rmse_mean_deg']:>7.2f}±{s['rmse_std_deg']:<6.2f} {sse_range}")
     if len(summary) > limit:
         lines.append(f"... {len(summary) - limit} more groups in summary.csv")

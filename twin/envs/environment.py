@@ -224,10 +224,8 @@ class JointTask(base.Task):
         """The action is the duty in %: a non-finite one is refused (InvalidAction); one outside
         [-100, 100] is clipped, and the first clip of an episode is reported (a warning)."""
         try:  # a number, not text or a truth value (NumPy reads "50" as 50 and True as 1)
-            given = np.asarray(action)
-            if given.dtype.kind == "O" and all(_a_number(x) for x in given.flat):
-                given = given.astype(float)  # Decimal, Fraction, an int past int64
-            if given.dtype.kind not in "iuf":
+            given = np.asarray(action)  # an object array: a Decimal, a Fraction, an int past int64
+            if given.dtype.kind not in "iuf" and not (given.dtype.kind == "O" and all(map(_a_number, given.flat))):
                 raise TypeError(given.dtype)
             duty = given.astype(float).reshape(1)
         except (TypeError, ValueError):
@@ -289,8 +287,7 @@ def load(task: str = "track", *, trajectory: int | None = 1, action_period: floa
     """
     if task not in TASKS:
         raise InvalidScenario(f"unknown task {task!r}: choose one of {', '.join(TASKS)}")
-    if trajectory is not None and (isinstance(trajectory, bool) or not isinstance(trajectory, numbers.Integral)
-                                   or trajectory not in (1, 2, 3, 4)):
+    if trajectory is not None and trajectory not in (1, 2, 3, 4):  # True or 1.0: refused by the Scenario below
         raise InvalidScenario(f"unknown trajectory {trajectory!r}: choose 1-4 or None (random)")
     randomise_load = task == "hold" and "payload" not in scenario and "orientation" not in scenario
     base_scenario = Scenario(controller, trajectory or 1, seed=seed, **scenario)

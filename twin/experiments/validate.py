@@ -217,6 +217,11 @@ def simulation_rows() -> list[dict]:
     return rows
 
 
+def sse_within(twin: float, measured: float) -> bool:
+    """Whether a twin's T1 SSE range is within :data:`SSE_TOLERANCE_DEG` of the measured one (False for nan)."""
+    return abs(twin - measured) <= SSE_TOLERANCE_DEG
+
+
 def measured_rows(cells: Sequence[calibrate.CellResult]) -> list[dict]:
     """Chapter 5's experiments and Chapter 6's T1 cells on ``as-built``: RMSE, then the T1 SSE ranges."""
     rows, sse_rows = [], []
@@ -229,7 +234,7 @@ def measured_rows(cells: Sequence[calibrate.CellResult]) -> list[dict]:
             twin = None if math.isnan(cell.sse_range) else cell.sse_range
             sse_rows.append(_row(f"{target.source}, T1 SSE range", cell.controller, 1, cell.payload_g,
                                  cell.orientation, "as-built", target.sse_range_deg, twin, None,
-                                 twin is not None and abs(twin - target.sse_range_deg) <= SSE_TOLERANCE_DEG))
+                                 twin is not None and sse_within(twin, target.sse_range_deg)))
     return rows + sse_rows
 
 
@@ -279,8 +284,8 @@ def seed_rows(fresh: Sequence[calibrate.CellResult], five: Sequence[calibrate.Ce
             twin = cell.sse_range
             five_range = mine.sse_range if mine else math.nan
             row.update(sse_measured=target.sse_range_deg, sse_five_run=None if math.isnan(five_range) else five_range,
-                       sse_twin=twin, sse_within_tolerance=abs(twin - target.sse_range_deg) <= SSE_TOLERANCE_DEG,
-                       sse_groups_within=sum(abs(r - target.sse_range_deg) <= SSE_TOLERANCE_DEG for r in ranges),
+                       sse_twin=twin, sse_within_tolerance=sse_within(twin, target.sse_range_deg),
+                       sse_groups_within=sum(sse_within(r, target.sse_range_deg) for r in ranges),
                        sse_group_low=min(ranges), sse_group_high=max(ranges), sse_group_ranges=ranges)
             signed = [x for x in cell.sse_deg if math.isfinite(x)]
             if len(signed) > 1:  # where the runs end, signed: for misses(), not a column of seeds.csv

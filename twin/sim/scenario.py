@@ -32,7 +32,8 @@ class Scenario:
     def __post_init__(self) -> None:
         if self.controller is not None and self.controller not in CONTROLLER_NAMES:
             raise InvalidScenario(f"unknown controller {self.controller!r}: choose one of {', '.join(CONTROLLER_NAMES)}")
-        if self.trajectory not in TRAJECTORY_NUMBERS:
+        if isinstance(self.trajectory, bool) or not isinstance(self.trajectory, numbers.Integral) \
+                or self.trajectory not in TRAJECTORY_NUMBERS:  # True == 1 and 1.0 == 1: not trajectories
             raise InvalidScenario(f"unknown trajectory {self.trajectory!r}: choose 1, 2, 3 or 4")
         if not isinstance(self.payload, numbers.Real) or not math.isfinite(self.payload) \
                 or not 0 <= self.payload <= MAX_PAYLOAD:
