@@ -6,7 +6,9 @@ ended (its trace is cut at its length) is no longer advanced (``PlantState(idle_
 evaluation (the 21 fitted cells x 5 seeds in one batch: 13 of the cells are 3 s T1 runs beside 6 s T4 ones)
 with the ended runs idle and with them run on to the batch's end, alternately, ``REPEATS`` times each, and
 prints the CPU times (less moved by other jobs on a shared machine than wall time), their ratio (fastest over
-fastest, and each pair's) and whether every RMSE is the same bits.
+fastest, and each pair's) and whether every RMSE is the same bits. It runs the tenth refit's fitted values
+(``twin/plants/data/tenth_refit.json``, digest 1c2dcd8c9f7f; first run on 2026-11-26 on the preset committed
+then), so a later refit does not change what it times.
 
     python examples/trial_idle_after_end.py
 """
@@ -18,7 +20,7 @@ import time
 
 import twin.sim.simulation as simulation
 from twin.experiments import calibrate
-from twin.plants.as_built import calibrated_values
+from twin.plants.as_built import TENTH_REFIT_FILE, calibrated_values
 from twin.sim.plant_state import PlantState
 
 REPEATS = 5
@@ -30,7 +32,7 @@ def running_on(**kwargs) -> PlantState:
 
 
 def main() -> None:
-    values = calibrated_values()
+    values = calibrated_values(TENTH_REFIT_FILE)
     jobs = [(*key, seed) for key in calibrate.CELLS for seed in SEEDS]
     calibrate._run_cells(values, [(*key, 0) for key in calibrate.CELLS])  # compile, build every cell's model
     times: dict[str, list[float]] = {"idle": [], "run on": []}  # CPU seconds of this process

@@ -8,11 +8,12 @@ the tank's pressure; one that had just been driven would start nearer the supply
 water the chambers are softest at low pressure, so a run from relaxed chambers needs more water before its
 first move: a candidate for PVA + DZC's T1 (x0.44), whose run starts from rest with the shortest commands.
 
-This script runs all 21 measured cells (§8's experiments and §9's T1 cells) on the committed as-built preset,
-seeds 0-4, with both chambers starting at 0, 0.25, 0.5 (as committed), 0.75 and 1.0 of the supply (gauge),
-nothing refitted; then from half the supply with the loop holding each run's start angle for 1 or 3 s before
-its trajectory (scored from the trajectory's start), as a rig whose loop ran before a run would leave its
-chambers. It prints per variant the cells within 20 % and the T1 steady-error ranges
+This script runs all 21 measured cells (§8's experiments and §9's T1 cells) on the committed as-built preset
+(the tenth refit's, committed when it ran: ``twin/plants/data/tenth_refit.json``, digest 1c2dcd8c9f7f, so a later
+refit does not move what it prints), seeds 0-4, with both chambers starting at 0, 0.25, 0.5 (as committed), 0.75
+and 1.0 of the supply (gauge), nothing refitted; then from half the supply with the loop holding each run's start
+angle for 1 or 3 s before its trajectory (scored from the trajectory's start), as a rig whose loop ran before a run
+would leave its chambers. It prints per variant the cells within 20 % and the T1 steady-error ranges
 within ±0.5 deg (the issue's bars, as ``twin validate`` judges them), then every cell's mean RMSE; then the
 held-back T3 cells of the blind prediction (committed preset only, no ensemble; what the assumption does to
 them, not a new prediction: none of these numbers chose anything). With 0.5
@@ -38,7 +39,7 @@ from twin.experiments.calibrate import TARGETS
 from twin.experiments.validate import PREDICTION_CELLS, rmse_within, sse_within
 from twin.physics.model import Orientation
 from twin.physics.trajectories import Segment, Trajectory
-from twin.plants.as_built import as_built_plant, preset_digest
+from twin.plants.as_built import TENTH_REFIT_FILE, as_built_plant, calibrated_values, preset_digest
 from twin.sim import simulation
 from twin.sim.scenario import Scenario
 from twin.sim.simulation import simulate_in_parts
@@ -52,8 +53,9 @@ NAMES = {"pva": "PVA", "ffpva": "FF+PVA", "smc": "SMC"}
 
 
 def plant_starting_at(fraction: float | None):
-    """The committed as-built plant, its chambers starting at ``fraction`` of the supply (None: as it is)."""
-    plant = as_built_plant()
+    """The committed (tenth refit's) as-built plant, its chambers starting at ``fraction`` of the supply (None: as
+    it is)."""
+    plant = as_built_plant(calibrated_values(TENTH_REFIT_FILE))
     if fraction is None:
         return plant
     chambers = dataclasses.replace(plant.params.chambers, initial_pressure_fraction=fraction)
@@ -132,8 +134,8 @@ def relaxing() -> str:
 def main(fresh: bool = False) -> None:
     seeds = FRESH_SEEDS if fresh else VERDICT_SEEDS
     committed = cells(None, seeds)
-    print(f"as-built preset {preset_digest()} (committed), seeds {seeds[0]}-{seeds[-1]}; chambers starting at "
-          f"0.5 of the supply give the committed runs bit for bit: {_same(cells(0.5, seeds), committed)}")
+    print(f"as-built preset {preset_digest(TENTH_REFIT_FILE)} (committed), seeds {seeds[0]}-{seeds[-1]}; chambers "
+          f"starting at 0.5 of the supply give the committed runs bit for bit: {_same(cells(0.5, seeds), committed)}")
     print(f"shut from half the supply, chambers A / B (kPa): {relaxing()}")
     variants = [(f"start at {f:g} of the supply", f, 0.0) for f in FRACTIONS]
     variants += [(f"held {h:g} s at the start angle first", None, h) for h in HELD]

@@ -16,15 +16,16 @@ slow motion would differ. This script runs that what-if two ways:
 beside the law as the thesis gives it, on the nine cells sliding mode was measured on (§8's T1-T4, §9's
 five T1 payload cells), seeds 0-9, with FF + PVA and PVA + DZC on §8's cells for the controller order. It ran
 first (2026-11-27) on the ninth refit's preset, committed then (``twin/plants/data/ninth_refit.json``, the
-default); ``--preset committed`` runs it on the committed preset (added in stop 39, 2026-11-27, on the tenth
-refit's). It also runs the six Chapter 6 T3 cells (0 / 6.5 / 13.5 g, horizontal and
+default); ``--preset tenth`` runs it on the tenth refit's (``twin/plants/data/tenth_refit.json``, digest
+1c2dcd8c9f7f; added in stop 39, 2026-11-27, as ``--preset committed``, its first line saying "(committed)", when
+the tenth was the committed preset). It also runs the six Chapter 6 T3 cells (0 / 6.5 / 13.5 g, horizontal and
 vertical) with both laws, to show what each reading would predict there and which law would lead: a
 what-if beside the blind prediction, which stays as committed. Nothing is refitted. The result is
 recorded in docs/studies-and-whatifs.md.
 
 About 40 s on 2 cores for either preset.
 
-    python examples/trial_smc_compensation.py [--preset ninth|committed]
+    python examples/trial_smc_compensation.py [--preset ninth|tenth]
 """
 
 from __future__ import annotations
@@ -41,11 +42,11 @@ from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_PAYLOADS_G, THESIS_ROBUSTNESS_T1_DEG
 from twin.experiments.validate import PREDICTION_CELLS, _order, rmse_within
 from twin.physics.model import Orientation
-from twin.plants.as_built import CALIBRATION_FILE, NINTH_REFIT_FILE, as_built_plant, calibrated_values, preset_digest
+from twin.plants.as_built import NINTH_REFIT_FILE, TENTH_REFIT_FILE, as_built_plant, calibrated_values, preset_digest
 from twin.sim.scenario import Scenario
 
 SEEDS = range(10)
-PRESETS = {"ninth": NINTH_REFIT_FILE, "committed": CALIBRATION_FILE}  # which calibration file the trial runs on
+PRESETS = {"ninth": NINTH_REFIT_FILE, "tenth": TENTH_REFIT_FILE}  # which calibration file the trial runs on
 BAND = FeedForwardPVAGains(pva=PVAGains()).compensation_band  # %, eq. 5.3.6, FF + PVA's compensation
 # (trajectory, payload g, orientation, measured mean RMSE deg): §8's and §9's sliding mode cells
 SMC_CELLS = (*((t, 0.0, "horizontal", THESIS_EXPERIMENT_RMSE_DEG["smc"][t][0]) for t in (1, 2, 3, 4)),

@@ -9,15 +9,17 @@ assumption after seeing them; the honest test is to refit and let the cost decid
 the start fraction for every as-built plant the fit builds (before the fit's workers fork, so they inherit it) and
 runs the calibration exactly as ``twin calibrate`` does (the same box, seeds, budgets, profiles and second start),
 then the T3 prediction's twelve cells on every member of the refitted ensemble, seeds 0-4, as ``twin validate``
-runs them. The cost is the committed fit's (the same cells, residuals and seeds), so the fits' costs compare with
-its 0.537 and its seed-to-seed noise 0.139. Fractions tried: 0 (relaxed: the tank's pressure), 0.25, 0.75, 1.0
-(the supply's), chosen before any of these fits ran.
+runs them. The cost is the committed fit's (the tenth refit's: the same cells, residuals and seeds), so the fits'
+costs compare with its 0.537 and its seed-to-seed noise 0.139. Fractions tried: 0 (relaxed: the tank's pressure),
+0.25, 0.75, 1.0 (the supply's), chosen before any of these fits ran.
 
 Run without ``--fraction``, it prints the committed preset's cost on the fit's seeds with the chambers starting at
-each fraction, nothing refitted (about 1 min). With ``--fraction`` it fits (5-8 min on 2 cores), prints the fitted
-values, the cost and its noise, the members, the measured cells and T1 steady-error ranges within the issue's bars
-on seeds 0-4 (best), then each T3 cell's value on the best, its band and the members' range, the stalled runs,
-and per member which law leads in each cell (``examples/trial_start_refit.py``'s report). ``--out DIR`` also writes
+each fraction, nothing refitted (about 1 min): the tenth refit's, committed when it ran
+(``twin/plants/data/tenth_refit.json``, digest 1c2dcd8c9f7f, so a later refit does not move what it prints). With
+``--fraction`` it fits (5-8 min on 2 cores), prints the fitted values, the cost and its noise, the members, the
+measured cells and T1 steady-error ranges within the issue's bars on seeds 0-4 (best), then each T3 cell's value on
+the best, its band and the members' range, the stalled runs, and per member which law leads in each cell
+(``examples/trial_start_refit.py``'s report). ``--out DIR`` also writes
 the calibration file there; ``--calibration FILE`` reports a file written before without fitting again (about 1
 min), after checking by its ``code_version`` (which hashes the presets as they ran) that it was fitted at that
 fraction, and first runs the measured cells again on its best values to show they give the file's table; with
@@ -37,53 +39,45 @@ pressure was corrected after the fits, on a review: the fits had recorded the co
 from __future__ import annotations
 
 import contextlib
-import functools
 import json
 import pathlib
 import sys
 
 from twin.experiments import calibrate
 from twin.experiments.validate import SSE_TOLERANCE_DEG, sse_within
-from twin.physics.params import ChamberParams
 from twin.plants import as_built
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling trials, however this one is loaded
 from trial_air_box import validate_on  # noqa: E402
 from trial_start_refit import checked_file, fitted_or_read, refit_arguments, report  # noqa: E402
 
-COMMITTED_FRACTION = ChamberParams().initial_pressure_fraction  # 0.5, as_built.ASSUMED
+COMMITTED_FRACTION = 0.5  # what every fit assumed until the eleventh refit (as_built.BEFORE_FITTED)
 FRACTIONS = (0.0, 0.25, 0.5, 0.75, 1.0)  # of the supply (gauge), in both chambers at the start
 
 
 @contextlib.contextmanager
 def chambers_starting_at(fraction: float):
-    """Every as-built plant built inside the block (and in every process forked in it) starts its chambers at
-    ``fraction`` of the supply, and a calibration file written in it says so (its ``assumed`` entry); after it, the
-    committed fraction and text."""
-    committed, said = as_built.ChamberParams, as_built.ASSUMED["initial_pressure_fraction"]
-    as_built.ChamberParams = functools.partial(ChamberParams, initial_pressure_fraction=fraction)
-    as_built.ASSUMED["initial_pressure_fraction"] = assumed_text(fraction)  # the dict calibrate.record copies
+    """Inside the block (and in every process forked in it) the trial's calibration files, fitted when the start
+    pressure was not a fitted value (file version 8), are read with their chambers starting at ``fraction`` of the
+    supply, the value they were fitted at; after it, as before. (Until the eleventh refit the block set the start of
+    every as-built plant, which then had none of its own: the fits ran so.)"""
+    before = as_built.BEFORE_FITTED
+    as_built.BEFORE_FITTED = {**before, "initial_pressure_fraction": fraction}
     try:
         yield
     finally:
-        as_built.ChamberParams = committed
-        as_built.ASSUMED["initial_pressure_fraction"] = said
-
-
-def assumed_text(fraction: float) -> str:
-    """What a trial calibration file fitted at ``fraction`` says of the chambers' start."""
-    return (f"both chambers start at {fraction:g} of the supply (a trial, examples/trial_start_pressure_refit.py; the "
-            "committed preset assumes half)")
+        as_built.BEFORE_FITTED = before
 
 
 def unfitted(workers: int) -> None:
-    """The committed preset's cost on the fit's seeds, its chambers starting at each of :data:`FRACTIONS`."""
-    values = as_built.calibrated_values()
+    """The committed (tenth refit's) preset's cost on the fit's seeds, its chambers starting at each of
+    :data:`FRACTIONS`."""
+    values = as_built.calibrated_values(as_built.TENTH_REFIT_FILE)  # with its start, 0.5, replaced below
     print(f"the committed preset, nothing refitted, cost on the fit's seeds {calibrate.FIT_SEEDS[0]}-"
-          f"{calibrate.FIT_SEEDS[-1]} (the file's: {json.loads(as_built.CALIBRATION_FILE.read_text())['cost']:.4f})")
+          f"{calibrate.FIT_SEEDS[-1]} (the file's: {json.loads(as_built.TENTH_REFIT_FILE.read_text())['cost']:.4f})")
     for fraction in FRACTIONS:
-        with chambers_starting_at(fraction), calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as ev:
-            cost = calibrate.cost(ev.cells(values))
+        with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as ev:
+            cost = calibrate.cost(ev.cells({**values, "initial_pressure_fraction": fraction}))
         print(f"chambers from {fraction:g} of the supply: cost {cost:.4f}", flush=True)
 
 
@@ -98,7 +92,7 @@ def ends(data: dict) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     parser, args = refit_arguments(__doc__, "fraction", "both chambers' start, of the supply (gauge), 0-1 (none: the "
-                                   "committed preset's cost at each of 0, 0.25, 0.5, 0.75 and 1, nothing refitted)",
+                                   "tenth refit's preset's cost at each of 0, 0.25, 0.5, 0.75 and 1, nothing refitted)",
                                    "examples/trial_start_pressure_refit/", argv,
                                    extra=lambda parser: parser.add_argument(
                                        "--validate", type=pathlib.Path, metavar="DIR", help="with --fraction and "
@@ -115,6 +109,10 @@ def main(argv: list[str] | None = None) -> None:
         return
     if not 0.0 <= args.fraction <= 1.0:
         parser.error(f"--fraction must be within 0-1 of the supply, got {args.fraction:g}")
+    if not args.calibration:
+        parser.error("the trial's fits ran on the code before the start pressure was fitted (commit 3e13ceb); since "
+                     "the eleventh refit twin calibrate fits it, so a fit here would not hold the fraction: report a "
+                     "kept file with --calibration")
     print(f"both chambers start at {args.fraction:g} of the supply (committed: {COMMITTED_FRACTION:g})")
     with chambers_starting_at(args.fraction):
         data = fitted_or_read(parser, args, f"with the chambers at {args.fraction:g} of the supply",

@@ -4,16 +4,17 @@ The thesis does not say where T1, T2 and T4 start. The twin starts them at 30 de
 inside the Coulomb fit's 24-174 deg, SPEC §4), and the calibration fits the measured cells run from there. On a
 joint turned on its side the start decides where the payload's weight acts during the move and the hold, so the
 vertical T1 cells, which pin how much margin the joint has to lift 13.5 g, read differently from another start.
-Run without ``--start``, this script shows how much, on the committed preset with nothing refitted: the six
-vertical T1 cells (FF + PVA and sliding mode, 0, 6.5 and 13.5 g) from each start of UNFITTED_STARTS_DEG, seeds
-0-4, against the measured means (about 20 s). T3 does not read this start (it starts at 80 deg), so the T3 cells
-do not depend on it directly; they may through the fit. This script measures that: it sets the start (``trajectories.START``, before the fit's
-workers fork, so they inherit it) and runs the calibration exactly as ``twin calibrate`` does (the same box,
-seeds, budgets, profiles and second start), then the T3 prediction's twelve cells on every member of the
-refitted ensemble, seeds 0-4, as ``twin validate`` runs them. Starts tried: 20 deg (T3's own lowest angle: the
-rig may have run T1 over T3's 20-140 deg, where the thesis's Hall sensor is linear, §5; for the twin it is below
-the Coulomb fit, which is clamped there, and where its model of the sensor's calibration errs most), 25 deg and
-40 deg, then 22 deg (after seeing the others).
+Run without ``--start``, this script shows how much, on the committed preset with nothing refitted (the tenth
+refit's, committed when it ran: ``twin/plants/data/tenth_refit.json``, digest 1c2dcd8c9f7f, so a later refit does
+not move what it prints): the six vertical T1 cells (FF + PVA and sliding mode, 0, 6.5 and 13.5 g) from each start
+of UNFITTED_STARTS_DEG, seeds 0-4, against the measured means (about 20 s). T3 does not read this start (it starts
+at 80 deg), so the T3 cells do not depend on it directly; they may through the fit. This script measures that: it
+sets the start (``trajectories.START``, before the fit's workers fork, so they inherit it) and runs the calibration
+exactly as ``twin calibrate`` does (the same box, seeds, budgets, profiles and second start), then the T3
+prediction's twelve cells on every member of the refitted ensemble, seeds 0-4, as ``twin validate`` runs them.
+Starts tried: 20 deg (T3's own lowest angle: the rig may have run T1 over T3's 20-140 deg, where the thesis's Hall
+sensor is linear, §5; for the twin it is below the Coulomb fit, which is clamped there, and where its model of the
+sensor's calibration errs most), 25 deg and 40 deg, then 22 deg (after seeing the others).
 
 It prints the fitted values, the cost and its noise, the members, the measured cells within 20 % on seeds 0-4,
 and each T3 cell's value on the best, its band and the members' range, the stalled runs, and per member which
@@ -48,6 +49,7 @@ from twin.experiments.reference import THESIS_ROBUSTNESS_T1_DEG
 from twin.experiments.validate import PREDICTION_CELLS, SEEDS, member_means, prediction_rows, rmse_within
 from twin.physics import trajectories
 from twin.physics.model import Orientation
+from twin.plants.as_built import TENTH_REFIT_FILE, as_built_plant, calibrated_values
 from twin.sim.scenario import Scenario
 
 COMMITTED_START_DEG = 30.0
@@ -73,14 +75,16 @@ def params_hash(version: str) -> str:
 
 
 def unfitted() -> None:
-    """The committed preset's six vertical T1 cells from each start of :data:`UNFITTED_STARTS_DEG`, seeds 0-4."""
+    """The committed (tenth refit's) preset's six vertical T1 cells from each start of :data:`UNFITTED_STARTS_DEG`,
+    seeds 0-4."""
+    plant = as_built_plant(calibrated_values(TENTH_REFIT_FILE))  # named "as-built", as the preset it ran on
     cells = [(law, grams) for law in ("ffpva", "smc") for grams in (0.0, 6.5, 13.5)]
     rig = " / ".join(f"{THESIS_ROBUSTNESS_T1_DEG[law, 'vertical'][g][0]:.2f}" for law, g in cells)
     print(f"T1 vertical, committed preset, nothing refitted, seeds 0-4: mean RMSE (deg) FF + PVA 0 / 6.5 / 13.5 g, "
           f"then sliding mode; the rig {rig}")
     for start in UNFITTED_STARTS_DEG:
         with started_at(start):
-            runs = run_many([Scenario(law, 1, payload=g * 1e-3, orientation=Orientation.VERTICAL, plant="as-built",
+            runs = run_many([Scenario(law, 1, payload=g * 1e-3, orientation=Orientation.VERTICAL, plant=plant,
                                       seed=s) for law, g in cells for s in SEEDS])
         means = [np.mean([math.degrees(r.metrics.rmse) for r in runs[i:i + len(SEEDS)]])
                  for i in range(0, len(runs), len(SEEDS))]

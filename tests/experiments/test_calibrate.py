@@ -3,8 +3,10 @@
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import json
 import math
+import pathlib
 
 import numpy as np
 import pytest
@@ -20,6 +22,8 @@ from twin.experiments.reference import (
 )
 from twin.physics.valves import ValveModel
 from twin.plants.as_built import CALIBRATION_FILE, FITTED, as_built_plant, calibrated_values, ensemble_values
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
 
 
 def exact_cells(scale: dict | None = None) -> list[CellResult]:
@@ -99,9 +103,10 @@ def test_ensemble_is_every_evaluation_within_the_noise_best_first_then_each_prof
 
     def v(f, a=0.01, load=0.2):
         return {"stiction": f, "air_fraction": a, "ccw_coulomb_scale": 1.2, "leak_conductance": 1e-14,
-                "load_friction": load, "observer_gain": 100.0}
+                "load_friction": load, "observer_gain": 100.0, "initial_pressure_fraction": 0.5}
 
-    assert calibrate.PROFILED == ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale", "air_fraction")
+    assert calibrate.PROFILED == ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale", "air_fraction",
+                                  "initial_pressure_fraction")
     history = [E(v(2.0), 1.00, "scan"), E(v(1.2), 1.04, "profile"), E(v(2.4), 1.05, "profile"),
                E(v(1.8), 1.02, "simplex"), E(v(1.8), 1.02, "simplex"), E(v(2.5), 1.30, "profile"),
                E(v(1.9, 0.02), 1.01, "simplex")]
@@ -165,15 +170,30 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
     assert (tmp_path / "c.png").stat().st_size > 0
 
 
-def test_the_second_start_is_the_ninth_refit_inside_the_box_and_one_outside_is_refused():
-    from twin.plants.as_built import NINTH_REFIT_FILE, preset_digest
+def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_one_outside_is_refused():
+    """The ninth and tenth refits' fitted values, with the chambers at half the supply as then assumed, then the four
+    start-pressure trial refits' at their fractions, each to the last bit of its kept file (the package's copy of the
+    trial fits is held to those files by their SHA-256)."""
+    from twin.plants.as_built import NINTH_REFIT_FILE, TENTH_REFIT_FILE, preset_digest
 
-    ninth = json.loads(NINTH_REFIT_FILE.read_text())
+    ninth, tenth = (json.loads(f.read_text()) for f in (NINTH_REFIT_FILE, TENTH_REFIT_FILE))
     assert preset_digest(NINTH_REFIT_FILE) == "57ff10bf5b36"  # the ninth refit's file, as committed on 2026-11-26
-    assert calibrate.previous_fits() == (ninth["fitted"],)  # to the last bit
+    assert preset_digest(TENTH_REFIT_FILE) == "1c2dcd8c9f7f"  # the tenth's, as committed on 2026-11-27
+    kept = json.loads(calibrate.START_PRESSURE_REFITS_FILE.read_text())["starts"]
+    trials = []
+    for start, fraction in zip(kept, (0.0, 0.25, 0.75, 1.0), strict=True):
+        source = ROOT / start["source"]
+        assert hashlib.sha256(source.read_bytes()).hexdigest() == start["source_sha256"]
+        fit = json.loads(source.read_text())
+        assert fit["assumed"]["initial_pressure_fraction"].startswith(f"both chambers start at {fraction:g} of")
+        assert start["cost"] == fit["cost"]
+        trials.append({**fit["fitted"], "initial_pressure_fraction": fraction})
+    half = {"initial_pressure_fraction": 0.5}
+    assert calibrate.previous_fits() == ({**ninth["fitted"], **half}, {**tenth["fitted"], **half}, *trials)
     box = {f.name: f for f in FITTED}
-    assert all(box[n].low <= v <= box[n].high for n, v in ninth["fitted"].items())
+    assert all(box[n].low <= v <= box[n].high for start in calibrate.previous_fits() for n, v in start.items())
     assert box["air_fraction"].high == 0.08 and ninth["bounds"]["air_fraction"]["high"] == 0.03
+    ninth = {"fitted": {**ninth["fitted"], **half}}
     outside = dict(ninth["fitted"], air_fraction=0.09)
     with pytest.raises(ValueError, match="air_fraction lies outside the box"):
         calibrate.calibrate(workers=1, previous=[outside])
@@ -184,28 +204,33 @@ def test_the_second_start_is_the_ninth_refit_inside_the_box_and_one_outside_is_r
         calibrate.calibrate(workers=1, previous=[dict(ninth["fitted"], extra=1.0)])
 
 
-def test_the_committed_file_holds_the_second_start_as_evaluated_and_as_a_member():
-    """The tenth refit's file: its last history row is the second start at exactly the ninth refit's values,
-    costing what the ninth refit's file says (to 1e-12: machines differ in the last bits), more than the best;
-    it is the ensemble's second member, and made_by says so."""
+def test_the_committed_file_holds_the_further_starts_as_evaluated_and_as_members():
+    """The eleventh refit's file: its six "previous" rows, after the simplex and before the profiles, are the further
+    starts at exactly their values, each costing what its own file says (to 1e-12: machines differ in the last
+    bits), within the noise, so each is a member; made_by says so, and the file is of this version."""
     committed = json.loads(CALIBRATION_FILE.read_text())
-    from twin.plants.as_built import NINTH_REFIT_FILE
+    from twin.plants.as_built import NINTH_REFIT_FILE, TENTH_REFIT_FILE
 
-    ninth = json.loads(NINTH_REFIT_FILE.read_text())
-    last = committed["history"][-1]
-    assert last["stage"] == "previous" and last["values"] == ninth["fitted"]
-    assert [h["stage"] for h in committed["history"]].count("previous") == 1
-    assert last["cost"] == pytest.approx(ninth["cost"], rel=1e-12) and last["cost"] > committed["cost"]
-    assert last["cost"] <= committed["cost"] + committed["noise"]["std"]  # within the noise: a member by the rule
-    assert committed["ensemble"][1] == last and committed["version"] == calibrate.FILE_VERSION == 8
-    assert "second start" in committed["made_by"]
+    stages = [h["stage"] for h in committed["history"]]
+    rows = [h for h in committed["history"] if h["stage"] == "previous"]
+    first = stages.index("previous")
+    assert stages[first:first + 6] == ["previous"] * 6 and "simplex" not in stages[first:] and "profile" not in stages[:first]
+    assert [r["values"] for r in rows] == list(calibrate.previous_fits())
+    kept = [json.loads(f.read_text())["cost"] for f in (NINTH_REFIT_FILE, TENTH_REFIT_FILE)] + [
+        t["cost"] for t in json.loads(calibrate.START_PRESSURE_REFITS_FILE.read_text())["starts"]]
+    assert [r["cost"] for r in rows] == pytest.approx(kept, rel=1e-12)
+    assert all(r["cost"] <= committed["cost"] + committed["noise"]["std"] for r in rows)  # within the noise
+    members = [m["values"] for m in committed["ensemble"]]
+    assert all(r["values"] in members for r in rows)
+    assert committed["version"] == calibrate.FILE_VERSION == 9 and "further starts" in committed["made_by"]
 
 
 def test_unit_box_maps_onto_the_plausible_bounds():
     assert values_at([0.0] * len(FITTED)) == {f.name: f.low for f in FITTED}
     assert values_at([1.0] * len(FITTED)) == {f.name: f.high for f in FITTED}
-    assert values_at([2.0, -1.0, 0.5, 0.5, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
-    assert calibrate.unit_of(values_at([0.25, 0.5, 0.75, 1.0, 0.1, 0.6])) == pytest.approx((0.25, 0.5, 0.75, 1.0, 0.1, 0.6))
+    assert values_at([2.0, -1.0, 0.5, 0.5, 0.5, 0.5, 0.5])[FITTED[0].name] == FITTED[0].high  # clipped, never outside
+    u = (0.25, 0.5, 0.75, 1.0, 0.1, 0.6, 0.3)
+    assert calibrate.unit_of(values_at(u)) == pytest.approx(u)
 
 
 def test_the_breakaway_bound_is_what_245_kpa_could_start_from_rest():
@@ -307,10 +332,10 @@ def test_same_seeds_same_fit_whatever_the_workers():
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    # two points along each profiled parameter (the load friction, the breakaway, the observer gain, the CCW scale,
-    # the air), then the second start, evaluated at exactly its values
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["profile"] * 10 + ["previous"]
-    assert one.history[-1].values == calibrate.previous_fits()[0] and one.evaluations == 14
+    # the six further starts, evaluated at exactly their values, then two points along each profiled parameter (the
+    # load friction, the breakaway, the observer gain, the CCW scale, the air, the start pressure)
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["previous"] * 6 + ["profile"] * 12
+    assert [e.values for e in one.history[3:9]] == list(calibrate.previous_fits()) and one.evaluations == 21
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)

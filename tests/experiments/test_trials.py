@@ -338,7 +338,7 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
     from twin.plants import as_built
 
     trial, folder, committed = (_load("trial_start_pressure_refit"), ROOT / "examples" / "trial_start_pressure_refit",
-                                as_built.ChamberParams)
+                                as_built.BEFORE_FITTED)
     trial.main([])  # the committed preset's cost from five start pressures, nothing refitted
     assert capsys.readouterr().out.splitlines() == [
         "the committed preset, nothing refitted, cost on the fit's seeds 0-9 (the file's: 0.5367)",
@@ -352,7 +352,7 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
     for fraction in ("0", "0.25", "0.75", "1"):
         trial.main(["--fraction", fraction, "--calibration", str(folder / f"fraction_{fraction}.json")])
         printed[fraction] = capsys.readouterr().out.splitlines()
-    assert as_built.ChamberParams is committed
+    assert as_built.BEFORE_FITTED is committed
     with pytest.raises(SystemExit):
         trial.main(["--fraction", "0.5", "--calibration", str(folder / "fraction_0.json")])
     assert "was not fitted with the chambers at 0.5 of the supply with these presets" in capsys.readouterr().err
@@ -446,6 +446,15 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS FFFFFS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
         ],
     }
+
+
+def test_trial_start_pressure_refit_fits_no_more(capsys):
+    """Its fits ran before the start pressure was fitted; twin calibrate now fits it, so a fit at a fixed fraction
+    would not hold it: refused, pointing to the commit they ran on."""
+    trial = _load("trial_start_pressure_refit")
+    with pytest.raises(SystemExit):
+        trial.main(["--fraction", "0.5"])
+    assert "before the start pressure was fitted (commit 3e13ceb)" in capsys.readouterr().err
 
 
 @pytest.mark.slow  # about 1 min: §8's eleven cells, ten seeds, nine ways (the plain runs and eight delays)
@@ -605,7 +614,7 @@ SMC_COMPENSATION = {
             "T2 0 g H 1.61 x1.04 | T3 0 g H 1.56 x0.92 | T4 0 g H 1.29 x0.71 | T1 6.5 g H 1.03 x0.79 | "
             "T1 13.5 g H 1.15 x0.94 | T1 0 g V 0.97 x0.62 | T1 6.5 g V 1.12 x0.74 | T1 13.5 g V 3.22 x0.92",
             "T3 sliding mode 1.56 / 1.71 / 1.92 / 1.57 / 1.80 / 2.77, ahead of FF + PVA on 6 of 6")}),
-    "committed": (  # the tenth refit's preset, committed since 2026-11-27 (stop 39); on another, re-run it and its docs
+    "tenth": (  # the tenth refit's preset (twin/plants/data/tenth_refit.json), committed when run (stop 39, as "committed")
         "FF + PVA T1-T4 1.45 / 2.42 / 2.37 / 1.87, PVA + DZC T1-T3 1.88 / 2.84 / 3.01",
         "FF + PVA: 2.37 / 2.64 / 2.88 / 2.30 / 2.61 / 3.71",
         {"as the thesis gives it": (
@@ -692,7 +701,8 @@ def test_trial_air_box_changes_only_the_air_top_and_puts_calibrate_back(monkeypa
     committed = {f.name: f for f in calibrate.FITTED}
     assert box["air_fraction"].high == trial.AIR_TOP == 0.08 and box["air_fraction"].low == 0.0
     assert {n: (f.low, f.high) for n, f in box.items() if n != "air_fraction"} == {
-        n: (f.low, f.high) for n, f in committed.items() if n != "air_fraction"}
+        n: (f.low, f.high) for n, f in committed.items() if n not in ("air_fraction", "initial_pressure_fraction")}
+    assert "initial_pressure_fraction" in committed  # fitted since the eleventh refit; the trial's runs held it
     # as it ran on 2026-11-27 (the tenth refit has since made calibrate's own profiles these five)
     assert trial.PROFILED == ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale", "air_fraction")
     assert trial.ENSEMBLE_MAX == 11
@@ -842,9 +852,19 @@ def test_the_ninth_refit_kept_for_the_trials_is_the_preset_the_docs_quote_them_o
     assert as_built.preset_digest(as_built.NINTH_REFIT_FILE) == "57ff10bf5b36"
 
 
+def test_the_tenth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
+    from twin.plants import as_built
+
+    # 1c2dcd8c9f7f: the committed preset from 2026-11-27 (the tenth refit), that the trials held here as committed
+    # (chapter6_supply, initial_pressure, smc_compensation's tenth, start_refit's and start_pressure_refit's
+    # unrefitted tables, t2_t3_choices) ran on; they read this copy, so a refit does not change what they print.
+    assert as_built.preset_digest(as_built.TENTH_REFIT_FILE) == "1c2dcd8c9f7f"
+
+
 @pytest.mark.parametrize(("heading", "folder", "member_count"), [
     ("## Beside the fifth: T3 on a trial refit", "trial_air_box", 11),
     ("## Fifth blind prediction: T3 on the ninth refit", "ninth_refit_prediction", 9),  # superseded, kept as packaged
+    ("## Sixth blind prediction: T3 on the tenth refit", "tenth_refit_prediction", 11),  # superseded 2026-11-28
 ])
 def test_prediction_md_quotes_the_registered_predictions_kept_in_examples(heading, folder, member_count):
     import csv

@@ -14,7 +14,7 @@ import pytest
 
 from twin.experiments import calibrate, score, validate
 from twin.experiments.reference import THESIS_PAYLOADS_G
-from twin.plants.as_built import calibration_cost_line, ensemble_costs, ensemble_values
+from twin.plants.as_built import calibrated_values, calibration_cost_line, ensemble_costs, ensemble_values
 
 NINTH_PROFILED = ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale")  # before the air (2026-11-27)
 
@@ -188,12 +188,18 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
     section = text[text.index("## Prediction: Chapter 6 T3 (blind)"):]
     assert ("T3 as the twin runs it: 80 ± 60 deg at 0.5 Hz for 4 s, starting mid-stroke at full speed" in section
             and "at a supply of 300 kPa, Chapter 5's;" in section
-            and "the band does not include the uncertainty of any of them" in section)
-    assert ("fitted on the measured cells with T1, T2 and T4 run from 30 deg and both chambers starting at 50 % of "
-            "the supply" in section and "nor what the chambers held when a run began" in section)
+            and "Of these the band includes only the chambers' start pressure" in section
+            and "it does not include the uncertainty of the others" in section)
+    fitted = round(calibrated_values()["initial_pressure_fraction"] * 100)
+    starts = [round(m["initial_pressure_fraction"] * 100) for m in ensemble_values()]
+    assert (f"fitted on the measured cells with T1, T2 and T4 run from 30 deg, and with what both chambers held when "
+            f"a run began fitted with the rest: {fitted} % of the supply on the committed preset, "
+            f"{min(starts)}-{max(starts)} % over the ensemble" in section
+            and "nor what the chambers held when a run began" in section)
     opening = text[text.index("## In short"):text.index("## Summary")]
-    assert "- **Blind T3 prediction**" in opening and "not over the choices the thesis leaves open" in opening
-    assert "where T1, T2 and T4 started, what the chambers held when a run began)" in opening
+    assert "- **Blind T3 prediction**" in opening and "not over the other choices the thesis leaves open" in opening
+    assert "(among them what the chambers held when a run began)" in opening
+    assert "(T3's length and start, the supply, where T1, T2 and T4 started)" in opening
     for trial in ("trial_t2_t3_choices", "trial_chapter6_supply", "trial_start_refit", "trial_start_pressure_refit"):
         assert f"`examples/{trial}.py`" in section
         assert (pathlib.Path(__file__).resolve().parents[2] / "examples" / f"{trial}.py").is_file()
@@ -217,7 +223,8 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
     monkeypatch.setattr(twin.plants, "plant", lower)
     other = validate.report(_fake(1.0, True, 0))
     assert "T3 as the twin runs it: 70 ± 60 deg at 0.5 Hz for 6 s" in other and "at a supply of 250 kPa;" in other
-    assert "with T1, T2 and T4 run from 40 deg and both chambers starting at 25 % of the supply" in other
+    assert ("with T1, T2 and T4 run from 40 deg, and with what both chambers held when a run began fitted with the "
+            "rest: 25 % of the supply on the committed preset" in other)
 
 
 def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_says():

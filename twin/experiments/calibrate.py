@@ -28,17 +28,18 @@ Search, deterministic (the same code and seeds give the same file):
 1. a scrambled Sobol design of :data:`SCAN_POINTS` points over the unit box (seed
    :data:`SCAN_SEED`), plus its centre;
 2. Nelder-Mead from the best of them, at most :data:`SIMPLEX_EVALUATIONS` evaluations;
-3. the seed-to-seed noise of the best cost: the best values so far on :data:`NOISE_SEED_SETS`
+3. further starts: the values of :func:`previous_fits` (earlier fits: the ninth and tenth refits',
+   and four trial refits with the chambers' start pressure held at 0, 0.25, 0.75 and 1.0 of the
+   supply), evaluated on the fit seeds like any other, so that a set known to fit is not lost to
+   the ensemble because the profiles, one parameter at a time about the best, never reach it, and
+   so that the noise and the profiles are taken about the best of them if one beats the search;
+4. the seed-to-seed noise of the best cost: the best values so far on :data:`NOISE_SEED_SETS`
    (each as many seeds as the fit, disjoint), noise = the sample std of those costs and the fit's;
-4. profiles (:data:`PROFILED`): the best values with the load friction at :data:`PROFILE_POINTS`
+5. profiles (:data:`PROFILED`): the best values with the load friction at :data:`PROFILE_POINTS`
    points across its box, then the best of all so far with the breakaway likewise (the two the
    vertical predictions turn on), then with the observer gain likewise, then with the CCW Coulomb
-   scale, then with the chambers' free air; the fitted values are then the lowest cost of all evaluations (a profile point may beat
-   the simplex);
-5. a second start: the values of :func:`previous_fits` (the ninth refit's, the best this search
-   found with the air held to 0-3 %), evaluated on the fit seeds like any other, so that a set
-   known to fit is not lost to the ensemble because the profiles, one parameter at a time about
-   the best, never reach it;
+   scale, then with the chambers' free air, then with their start pressure; the fitted values are
+   then the lowest cost of all evaluations (a profile point may beat the simplex);
 6. the ensemble: every evaluated parameter set whose cost is within the noise of the best
    (cost <= best + noise), at most :data:`ENSEMBLE_MAX` of them (the best first, then the
    lowest and highest of each profiled parameter, then by cost).
@@ -47,6 +48,7 @@ Search, deterministic (the same code and seeds give the same file):
 from __future__ import annotations
 
 import dataclasses
+import importlib.resources
 import json
 import math
 import os
@@ -63,7 +65,7 @@ from twin.experiments.reference import (
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
     THESIS_ROBUSTNESS_T1_DEG,
 )
-from twin.plants.as_built import ASSUMED, FITTED, NINTH_REFIT_FILE, as_built_plant, calibrated_values
+from twin.plants.as_built import ASSUMED, FITTED, NINTH_REFIT_FILE, TENTH_REFIT_FILE, as_built_plant, calibrated_values
 from twin.sim.metrics import spread
 from twin.sim.scenario import Scenario
 
@@ -81,22 +83,32 @@ PROFILE_POINTS = 5  # per profiled parameter
 # the fourth, the CCW friction, moves the cells little (on the eighth refit a scale of 1.1 cost 0.564 against the
 # best's 0.551 at 1.299, noise 0.173: found 2026-11-26, after that fit), so its spread belongs in the band.
 # The fifth, the air, turns which law leads on T3 (docs/prediction.md); profiled since 2026-11-27, when its box
-# was widened to 0-8 % (twin.plants.as_built.FITTED).
-PROFILED = ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale", "air_fraction")
+# was widened to 0-8 % (twin.plants.as_built.FITTED). The sixth, the chambers' start pressure, moves the 13.5 g
+# vertical T3 cells past their band at about the same cost (docs/prediction.md); fitted and profiled since 2026-11-28.
+PROFILED = ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale", "air_fraction",
+            "initial_pressure_fraction")
 ENSEMBLE_MAX = 1 + 2 * len(PROFILED)  # the best and each profiled parameter's two extremes
-FILE_VERSION = 8  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction;
+FILE_VERSION = 9  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction;
 # 6: the observer gain; 7: the CCW scale's top from §4.5.1's slowest full-duty speed, and profiled;
-# 8: the air's box 0-8 % and profiled, and the second start (previous_fits)
+# 8: the air's box 0-8 % and profiled, and the second start (previous_fits); 9: the chambers' start pressure
+# fitted and profiled, five further starts, the starts evaluated before the noise and the profiles
 # The second start: the ninth refit's fitted values (file version 7, 2026-11-26;
 # twin.plants.as_built.NINTH_REFIT_FILE), the best of the same search with the air's box 0-3 %. They cost 0.5587 on
 # the fit seeds; the search with the box at 0-8 % settles at 4.6 % air for 0.5367, with a noise of 0.139, and its
 # profiles alone put no set with less than 3.98 % air in the ensemble (its 2 % point costs 0.83). Added 2026-11-27,
-# after seeing that (docs/calibration-history.md).
+# after seeing that (docs/calibration-history.md). Since file version 9 (2026-11-28) the tenth refit's fitted values
+# and the four trial refits at fixed start pressures are starts too, chosen before this search first ran (the
+# start-angle trial's fits are not: they were made with T1, T2 and T4 from another angle).
+START_PRESSURE_REFITS_FILE = importlib.resources.files("twin.plants") / "data" / "start_pressure_refits.json"
 
 
 def previous_fits() -> tuple[dict[str, float], ...]:
-    """The second start's parameter sets: the ninth refit's fitted values, read from its kept file."""
-    return (calibrated_values(NINTH_REFIT_FILE),)
+    """The further starts' parameter sets, in this order: the ninth and the tenth refits' fitted values (read from
+    their kept files, so with the chambers at half the supply, as fitted), then the four start-pressure trial refits'
+    (:data:`START_PRESSURE_REFITS_FILE`, each with its fraction)."""
+    trials = json.loads(START_PRESSURE_REFITS_FILE.read_text())["starts"]
+    return (calibrated_values(NINTH_REFIT_FILE), calibrated_values(TENTH_REFIT_FILE),
+            *({f.name: float(t["values"][f.name]) for f in FITTED} for t in trials))
 
 
 @dataclasses.dataclass(frozen=True)
@@ -380,17 +392,17 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
               simplex_evaluations: int = SIMPLEX_EVALUATIONS, profile_points: int = PROFILE_POINTS,
               previous: Sequence[dict[str, float]] | None = None,
               progress: Callable[[int, int, str, float, dict], None] | None = None) -> Calibration:
-    """Fit :data:`twin.plants.as_built.FITTED` (see the module docstring). ``previous``: the second start's
+    """Fit :data:`twin.plants.as_built.FITTED` (see the module docstring). ``previous``: the further starts'
     values (each must lie in the box; None: :func:`previous_fits`). ``progress(done, total, stage, cost, values)``
     after each evaluation."""
     previous = previous_fits() if previous is None else tuple(previous)
     for values in previous:
         if set(values) != {f.name for f in FITTED}:
-            raise ValueError(f"a second start must give exactly the fitted parameters {[f.name for f in FITTED]}, "
+            raise ValueError(f"a further start must give exactly the fitted parameters {[f.name for f in FITTED]}, "
                              f"not {sorted(values)}")
         outside = [f.name for f in FITTED if not f.low <= values[f.name] <= f.high]
         if outside:
-            raise ValueError(f"a second start's {', '.join(outside)} lies outside the box")
+            raise ValueError(f"a further start's {', '.join(outside)} lies outside the box")
     from scipy.optimize import minimize
     from scipy.stats import qmc
 
@@ -442,6 +454,9 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
             except _BudgetSpent:
                 pass
             budget = math.inf
+        stage = "previous"
+        for values in previous:  # evaluated as given (the unit box's round trip would move their last bits)
+            objective(unit_of(values), {f.name: values[f.name] for f in FITTED})
         best_key = lowest()
         stage = "noise"
         noise_costs = [seen[best_key][0].cost]
@@ -453,12 +468,6 @@ def calibrate(*, workers: int = 2, fit_seeds: Sequence[int] = FIT_SEEDS, check_s
             index, centre = FITTED_INDEX[name], lowest()
             for x in np.linspace(0.0, 1.0, profile_points):
                 objective([x if i == index else centre[i] for i in range(len(FITTED))])
-        stage = "previous"
-        for values in previous:  # evaluated as given (the unit box's round trip would move their last bits)
-            objective(unit_of(values), {f.name: values[f.name] for f in FITTED})
-        # After the noise and the profiles: if a second start ever cost less than the best, it would become the
-        # fitted values below without profiles of its own, and the noise would be the other point's (on the tenth
-        # refit it costs more: 0.5587 against 0.5367).
         # A profile point may beat the simplex (the cost is flat along the breakaway, within the noise):
         # the fitted values are the lowest cost evaluated.
         best, fit_cells = seen[lowest()]
@@ -505,7 +514,7 @@ def record(result: Calibration) -> dict:
         "code_version": code_version(plants=fit_presets(result.values)),
         "made_by": f"twin calibrate (Sobol scan of {SCAN_POINTS} + centre, Nelder-Mead, profiles of "
                    f"{' and '.join(PROFILED)}; "
-                   + (f"a second start from the ninth refit's values ({starts}, stage 'previous'); "
+                   + (f"further starts from earlier fits ({starts}, stage 'previous'); "
                       if (starts := sum(e.stage == "previous" for e in result.history)) else "")
                    + f"{result.evaluations} evaluations on fit seeds {list(result.fit_seeds)})",
         "loss": f"Cauchy, scale ln 1.2 = {LOSS_SCALE:.4f}; SSE-range residuals weighted sqrt({SSE_WEIGHT})",
@@ -514,7 +523,7 @@ def record(result: Calibration) -> dict:
         "bounds": {f.name: {"low": f.low, "high": f.high, "unit": f.unit, "why": f.why} for f in FITTED},
         "assumed": ASSUMED,
         "cost": result.cost,
-        "noise": {"how": "the best values before the profiles: their cost on the fit seeds and on each further seed set "
+        "noise": {"how": "the best values after the further starts, before the profiles: their cost on the fit seeds and on each further seed set "
                          "of the same size; noise = their sample std; the ensemble is every evaluated set with "
                          "cost <= best + noise",
                   "seed_sets": [list(result.fit_seeds), *(list(s) for s in result.noise_seed_sets)],

@@ -106,6 +106,10 @@ REGISTERED = (
     Registration("the air-box trial's prediction (examples/trial_air_box)", "2026-11-27", "3da50147f0ac",
                  "9a133fe747948cb0f2e545f1cfb91eb747337ec1cdcf50c050ae0803b764ea8f",
                  "37fe7c0cde01d1201163677fc6df1d5b2f16228b36ead834fa8185c0a122bcb5"),
+    Registration("the seventh blind prediction (the eleventh refit's; the sixth's files now in "
+                 "examples/tenth_refit_prediction)", "2026-11-28", "78c00bbdf7e4",
+                 "45b22c579d3cffb7071c12532cd5728eda7af9905332ad1178ccf62049d9abb7",
+                 "5af4f15319e6598089c10508607f6f0735b0a48ef078195803026f2eae1b2194"),
 )
 TIE = "tie"  # the two means equal: neither tracked better (and the order is a toss)
 ORDER_LABELS = {**CONTROLLER_LABELS, TIE: "neither (equal means)"}

@@ -65,6 +65,7 @@ PARAMETER_TEXT = {
     "leak_conductance": ("leak", lambda x: f"{x * 1e14:.2f}", "x 1e-14 m^3/(Pa s)"),
     "load_friction": ("load friction", lambda x: f"{x:.2f}", "N/N"),
     "observer_gain": ("observer gain", lambda x: f"{x:.0f}", "1/s"),
+    "initial_pressure_fraction": ("chambers' start", lambda x: f"{x * 100:.0f}", "% of the supply"),
 }
 
 
@@ -92,6 +93,14 @@ def _profiled(members: Sequence[dict]) -> list[str]:
             + [n for n in carried if n not in calibrate.PROFILED and len({m[n] for m in members}) > 1])
 
 
+def _start_pressure_fitted() -> bool:
+    """Whether the calibration fits the chambers' start pressure (since the eleventh refit; a trial reading an older
+    file puts the box it ran on in place, ``twin.plants.as_built.FITTED`` as it is when asked)."""
+    from twin.plants import as_built
+
+    return "initial_pressure_fraction" in {f.name for f in as_built.FITTED}
+
+
 def _t3_as_run_text() -> str:
     """Sentences on the T3 cells as the twin runs them: T3 (``twin.physics.trajectories``; its middle, amplitude
     and length, which SPEC §7 does not fix all of), the supply pressure (the as-built plant's, which §9 does not
@@ -99,12 +108,20 @@ def _t3_as_run_text() -> str:
     matter. The start is ``trajectories.START`` as the report runs: the committed calibration was fitted with it,
     since its ``code_version`` (which hashes the trajectories) is the sweep store's. The trial's numbers are the
     tenth refit's and said as such. Added 2026-11-27 (stop 38), after the trials it points to; the chambers' start
-    pressure (the as-built plant's, an assumption) and its trial added 2026-11-28 (stop 42), after that trial."""
+    pressure (the as-built plant's, an assumption) and its trial added 2026-11-28 (stop 42), after that trial; the
+    start pressure fitted, and said so, since 2026-11-28 (stop 43)."""
     from twin.physics.params import NOMINAL_PARAMS
     from twin.physics.trajectories import trajectory
-    from twin.plants import plant
+    from twin.plants import as_built, plant
 
     params = plant("as-built").params
+    starts = [p.params.chambers.initial_pressure_fraction * 100 for p in as_built.ensemble_plants()]
+    fitted = _start_pressure_fitted()
+    chambers = (f"and with what both chambers held when a run began fitted with the rest: "
+                f"{params.chambers.initial_pressure_fraction * 100:.0f} % of the supply on the committed preset, "
+                f"{min(starts):.0f}-{max(starts):.0f} % over the ensemble" if fitted else
+                f"and with both chambers starting at {params.chambers.initial_pressure_fraction * 100:.0f} % of the "
+                "supply, not fitted")
     t3 = trajectory(3, spur_radius=params.gears.spur_radius)
     (sine,) = t3.segments
     chapter5 = ", Chapter 5's" if params.supply.pressure == NOMINAL_PARAMS.supply.pressure else ""
@@ -112,17 +129,22 @@ def _t3_as_run_text() -> str:
     return (f"T3 as the twin runs it: {math.degrees(t3.start):g} ± {math.degrees(sine.delta):g} deg at 0.5 Hz for "
             f"{t3.duration:g} s, starting mid-stroke at full speed (the thesis simulated its largest error at T3's start), "
             f"at a supply of {params.supply.pressure / 1e3:g} kPa{chapter5}; the committed preset was fitted on the "
-            f"measured cells with T1, T2 and T4 run from {math.degrees(t1.start):g} deg and both chambers starting at "
-            f"{params.chambers.initial_pressure_fraction * 100:g} % of the supply. The thesis states neither T3's length nor "
-            "its start nor where T1, T2 and T4 started nor what the chambers held when a run began, nor restates the "
-            "supply for Chapter 6, and the band does not include the uncertainty of any of them: it is the spread over "
-            "the fitted parameters with these held. docs/prediction.md in the repository records a trial of each "
+            f"measured cells with T1, T2 and T4 run from {math.degrees(t1.start):g} deg, {chambers}. The thesis "
+            "states neither T3's length nor its start nor where T1, T2 and T4 started nor what the chambers held when a "
+            "run began, nor restates the supply for Chapter 6. "
+            + ("Of these the band includes only the chambers' start pressure, as far as the measured cells leave it "
+               "open (the spread over the fitted parameters); it does not include the uncertainty of the others, "
+               "which it holds as said." if fitted else
+               "The band does not include the uncertainty of any of them: it is the spread over the fitted parameters "
+               "with these held.")
+            + " docs/prediction.md in the repository records a trial of each "
             "(`examples/trial_t2_t3_choices.py`, `examples/trial_start_refit.py`, "
             "`examples/trial_start_pressure_refit.py`, `examples/trial_chapter6_supply.py`); the 13.5 g vertical "
             "cells depend on them most. On the tenth refit (committed 2026-11-27), refitted about as well with T1, T2 "
             "and T4 from 20 deg, those two cells came out 4.84 and 4.28 deg (FF + PVA, sliding mode), above that "
             "preset's band (whose tops were 3.81 and 3.48); refitted about as well with the chambers starting at the "
-            "supply's pressure, 3.37 and 2.97 deg, below it (whose bottoms were 3.62 and 3.38).")
+            "supply's pressure, 3.37 and 2.97 deg, below it (whose bottoms were 3.62 and 3.38): the trial that led to "
+            "fitting the start pressure.")
 
 
 def _fixed_text(members: Sequence[dict]) -> str:
@@ -1699,9 +1721,13 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
                         + (f". Across the ensemble: {members_text}" if members_text else "") + ". " if both else "")
                      + ("No run of any ensemble member stalls." if not stalls else
                         f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}.")
-                     + " The band is the spread over the fitted parameters only, not over the choices the thesis "
-                       "leaves open (T3's length and start, the supply, where T1, T2 and T4 started, what the chambers "
-                       "held when a run began), which the prediction section names.")
+                     + (" The band is the spread over the fitted parameters only (among them what the chambers held "
+                        "when a run began), not over the other choices the thesis leaves open (T3's length and start, "
+                        "the supply, where T1, T2 and T4 started), which the prediction section names."
+                        if _start_pressure_fitted() else
+                        " The band is the spread over the fitted parameters only, not over the choices the thesis "
+                        "leaves open (T3's length and start, the supply, where T1, T2 and T4 started, what the "
+                        "chambers held when a run began), which the prediction section names."))
     return lines
 
 

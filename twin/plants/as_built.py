@@ -59,6 +59,9 @@ CALIBRATION_FILE = importlib.resources.files("twin.plants") / "data" / "as_built
 # The ninth refit's calibration file (committed 2026-11-26 to 2026-11-27, digest 57ff10bf5b36), kept as it was:
 # the trials that ran on it read it, and `twin calibrate` starts a second time from its fitted values.
 NINTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "ninth_refit.json"
+# The tenth refit's calibration file (committed 2026-11-27 to 2026-11-28, digest 1c2dcd8c9f7f), kept as it was: the
+# trials that ran on it read it, and `twin calibrate` starts from its fitted values too.
+TENTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "tenth_refit.json"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -135,12 +138,19 @@ FITTED = (
            "them sliding mode's sigma. Bottom: 30 1/s, where the estimate lags T4's half-second cycloids (12.6 rad/s) "
            "by 23 deg. Top: 1000 1/s, K_OB times the 1 ms sample = 1: the estimate then averages under two samples "
            "and the Hall noise alone (+-0.02 mm) gives about 9 mm/s of velocity noise, most of T2's 10 mm/s"),
+    Fitted("initial_pressure_fraction", 0.0, 1.0, "", "the gauge pressure both chambers hold when a run starts, "
+           "as a fraction of the supply; the thesis does not say. Bottom: the tank's (the chambers relaxed). Top: "
+           "the supply's (the most a shut valve can trap). Until 2026-11-28 (file version 8) it was assumed half "
+           "the supply; fitted since a trial found the 13.5 g vertical T3 cells turning on it by more than their "
+           "band, the cost not (docs/calibration-history.md)"),
 )
+# What a calibration file from before file version 9, which had no start pressure among its fitted values, was
+# fitted with (then an assumption: both chambers at half the supply); it is read so.
+BEFORE_FITTED = {"initial_pressure_fraction": 0.5}
+FIRST_VERSION_FITTING = {"initial_pressure_fraction": 9}  # the file version that first fitted each of BEFORE_FITTED
 
 ASSUMED = {
     "dead_volume": "0.3 mL per chamber at the end of stroke: ports, fittings and hose to the valve block",
-    "initial_pressure_fraction": "both chambers start at half the supply (the thesis pre-charges the joint "
-                                 "by moving it side to side; the shut valves then trap a middle pressure)",
     "stiction_map": f"scatter {STICTION_SCATTER} N about the fitted breakaway, knots 1 mm apart, one map per run "
                     "(drawn from the run's seed)",
     "supply_line": "60 Hz, damping ratio 0.3, 2e-13 m^3/Pa at the valve block: a hose ringing near the 62.5 Hz "
@@ -162,7 +172,12 @@ def _record(path: pathlib.Path) -> dict:
         raise InvalidScenario(f"cannot read the as-built calibration {path}: {error}") from None
 
 
-def _checked(values: object, path: pathlib.Path, what: str) -> dict[str, float]:
+def _checked(values: object, path: pathlib.Path, what: str, version: object = None) -> dict[str, float]:
+    """The fitted values of ``values``, each in its box; a file of a ``version`` before one of them was fitted gives
+    that one as :data:`BEFORE_FITTED`."""
+    if isinstance(values, dict) and isinstance(version, int):
+        values = {**{name: value for name, value in BEFORE_FITTED.items() if version < FIRST_VERSION_FITTING[name]},
+                  **values}
     try:
         out = {f.name: float(values[f.name]) for f in FITTED}  # type: ignore[index]
     except (TypeError, ValueError, KeyError) as error:
@@ -178,7 +193,8 @@ def _checked(values: object, path: pathlib.Path, what: str) -> dict[str, float]:
 def calibrated_values(path: pathlib.Path | None = None) -> dict[str, float]:
     """The fitted values from ``path`` (the committed calibration by default)."""
     path = _file(path)
-    return _checked(_record(path).get("fitted"), path, "fitted values")
+    record = _record(path)
+    return _checked(record.get("fitted"), path, "fitted values", record.get("version"))
 
 
 def ensemble_values(path: pathlib.Path | None = None) -> list[dict[str, float]]:
@@ -188,8 +204,8 @@ def ensemble_values(path: pathlib.Path | None = None) -> list[dict[str, float]]:
     path = _file(path)
     record = _record(path)
     members = record.get("ensemble") or [{"values": record.get("fitted")}]
-    return [_checked(m.get("values") if isinstance(m, dict) else None, path, f"ensemble member {k}")
-            for k, m in enumerate(members)]
+    return [_checked(m.get("values") if isinstance(m, dict) else None, path, f"ensemble member {k}",
+                     record.get("version")) for k, m in enumerate(members)]
 
 
 def ensemble_costs(path: pathlib.Path | None = None) -> list[float | None]:
@@ -219,7 +235,9 @@ def calibration_cost_line(path: pathlib.Path | None = None) -> tuple[float, floa
 
 def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) -> tuple[JointParams, dict]:
     """Joint parameters with the fitted ``values``, minus the effects named in ``without``;
-    also the plant options (gain set, scoring) those effects set."""
+    also the plant options (gain set, scoring) those effects set. Values from a fit made before one of them was
+    fitted (a file's ``fitted`` as it was written) take it as :data:`BEFORE_FITTED`, as that fit did."""
+    values = {**BEFORE_FITTED, **values}
     off = set(without)
     unknown = off - set(EFFECTS)
     if unknown:
@@ -239,7 +257,8 @@ def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) ->
         valves=base.valves,
         friction=friction,
         chambers=(ChamberParams(compressible=True, air_fraction=values["air_fraction"],
-                                leak_conductance=values["leak_conductance"])
+                                leak_conductance=values["leak_conductance"],
+                                initial_pressure_fraction=values["initial_pressure_fraction"])
                   if "compressibility" in on else ChamberParams()),
         supply_line=SupplyLineParams(model="line") if "supply_line" in on else SupplyLineParams(),
         hall=HallParams(calibration_error="hall_calibration" in on),
