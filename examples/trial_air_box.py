@@ -67,9 +67,13 @@ ENSEMBLE_MAX = 1 + 2 * len(PROFILED)
 def trial_box() -> tuple:
     """calibrate's box with the air's top at :data:`AIR_TOP`, as it ran: without the chambers' start pressure, which
     was fitted only from the eleventh refit on (the trial's runs start at half the supply, as every fit then did)."""
-    return tuple(dataclasses.replace(f, high=AIR_TOP, why=f"trial: none to {AIR_TOP * 100:g} %")
-                 if f.name == "air_fraction" else f for f in calibrate.FITTED
-                 if f.name not in as_built.BEFORE_FITTED)
+    box = tuple(dataclasses.replace(f, high=AIR_TOP, why=f"trial: none to {AIR_TOP * 100:g} %")
+                if f.name == "air_fraction" else f for f in calibrate.FITTED if f.name not in as_built.BEFORE_FITTED)
+    # calibrate.FITTED_INDEX, built once from the whole box, must still place each kept parameter: the dropped ones
+    # are the box's last
+    if [f.name for f in box] != [f.name for f in calibrate.FITTED][:len(box)]:
+        raise AssertionError("the trial's box is not the committed one's first parameters")
+    return box
 
 
 @contextlib.contextmanager
@@ -78,10 +82,14 @@ def trial_search():
     as it was after it, whatever happens in it."""
     saved = calibrate.FITTED, calibrate.PROFILED
     calibrate.FITTED, calibrate.PROFILED = trial_box(), PROFILED
+    # a file written in the block states the start pressure it was fitted with (the dict calibrate.record copies)
+    as_built.ASSUMED["initial_pressure_fraction"] = ("both chambers start at half the supply (as every fit did until "
+                                                     "the eleventh refit, which fits it)")
     try:
         yield
     finally:
         calibrate.FITTED, calibrate.PROFILED = saved
+        del as_built.ASSUMED["initial_pressure_fraction"]
 
 
 def run(workers: int) -> calibrate.Calibration:

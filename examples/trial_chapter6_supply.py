@@ -12,7 +12,7 @@ This script runs, on the tenth refit's as-built preset (committed when it ran: `
 digest 1c2dcd8c9f7f, so a later refit does not move what it prints) and seeds 0-4 (the verdicts' seeds), Chapter
 6's ten T1 cells that are not §8's (FF + PVA and sliding mode; 6.5 g and 13.5 g horizontal; 0, 6.5 and 13.5 g
 vertical) and the blind prediction's twelve T3 cells at each supply pressure of PRESSURES_KPA, nothing refitted.
-At 300 kPa the T3 runs are the committed ones (the script checks it, bit for bit, against runs with the plant's own
+At 300 kPa the T3 runs are the tenth refit's plain ones (the script checks it, bit for bit, against runs with the plant's own
 pressure). It prints per pressure:
 - the T1 cells within 20 % of their measured means (of ten), and the two 13.5 g vertical T1 cells against
   theirs;

@@ -1,8 +1,8 @@
 """Trial (not installed): does where the chambers' pressure starts move any measured cell?
 
-Every as-built run starts with both chambers at half the supply (``initial_pressure_fraction`` 0.5, an
-assumption: the thesis pre-charged the joint by moving it side to side, and shut valves then trap a middle
-pressure). The thesis does not say what the chambers held when a run began. A joint that sat for a while
+Until the eleventh refit (2026-11-28), which fits it, every as-built run started with both chambers at half the
+supply (``initial_pressure_fraction`` 0.5, then an assumption: the thesis pre-charged the joint by moving it side
+to side, and shut valves then trap a middle pressure). The thesis does not say what the chambers held when a run began. A joint that sat for a while
 with its valves shut would have let its chambers relax through the leak past the discharge valves, towards
 the tank's pressure; one that had just been driven would start nearer the supply. With free air in the
 water the chambers are softest at low pressure, so a run from relaxed chambers needs more water before its
@@ -10,7 +10,7 @@ first move: a candidate for PVA + DZC's T1 (x0.44), whose run starts from rest w
 
 This script runs all 21 measured cells (§8's experiments and §9's T1 cells) on the committed as-built preset
 (the tenth refit's, committed when it ran: ``twin/plants/data/tenth_refit.json``, digest 1c2dcd8c9f7f, so a later
-refit does not move what it prints), seeds 0-4, with both chambers starting at 0, 0.25, 0.5 (as committed), 0.75
+refit does not move what it prints), seeds 0-4, with both chambers starting at 0, 0.25, 0.5 (as the tenth refit had it), 0.75
 and 1.0 of the supply (gauge), nothing refitted; then from half the supply with the loop holding each run's start
 angle for 1 or 3 s before its trajectory (scored from the trajectory's start), as a rig whose loop ran before a run
 would leave its chambers. It prints per variant the cells within 20 % and the T1 steady-error ranges

@@ -1,26 +1,28 @@
 """Trial (not installed): the calibration refitted with the chambers starting at another pressure.
 
-Every as-built run starts with both chambers at half the supply (``initial_pressure_fraction`` 0.5, assumed:
-``twin.plants.as_built.ASSUMED``); the thesis does not say what the chambers held when a run began.
+Until the eleventh refit (2026-11-28) every as-built run started with both chambers at half the supply
+(``initial_pressure_fraction`` 0.5, then an assumption); the thesis does not say what the chambers held when a run
+began. (Since then ``twin calibrate`` fits it, in part because of this trial: docs/calibration-history.md.)
 ``examples/trial_initial_pressure.py`` (stop 40) showed, with nothing refitted, that this assumption moves the
 verdict counts: from the tank's pressure (0) 12 of the 13 T1 steady-error ranges are within ±0.5 deg on seeds 0-4,
 against 9 from half the supply, while FF + PVA's T1 RMSE goes out. Choosing a start by those counts would choose an
-assumption after seeing them; the honest test is to refit and let the cost decide. This script does that: it sets
-the start fraction for every as-built plant the fit builds (before the fit's workers fork, so they inherit it) and
-runs the calibration exactly as ``twin calibrate`` does (the same box, seeds, budgets, profiles and second start),
-then the T3 prediction's twelve cells on every member of the refitted ensemble, seeds 0-4, as ``twin validate``
-runs them. The cost is the committed fit's (the tenth refit's: the same cells, residuals and seeds), so the fits'
+assumption after seeing them; the honest test is to refit and let the cost decide. This script did that on
+2026-11-28 (stop 42): it set the start fraction for every as-built plant the fit built (before the fit's workers
+forked, so they inherited it) and ran the calibration exactly as ``twin calibrate`` did then (file version 8: the
+same box, seeds, budgets, profiles and second start), then the T3 prediction's twelve cells on every member of the
+refitted ensemble, seeds 0-4, as ``twin validate`` runs them. It no longer fits: ``twin calibrate`` now fits the
+fraction itself, so a fit here would not hold it (the fits need commit 3e13ceb); it reports the kept files. The cost is the committed fit's (the tenth refit's: the same cells, residuals and seeds), so the fits'
 costs compare with its 0.537 and its seed-to-seed noise 0.139. Fractions tried: 0 (relaxed: the tank's pressure),
 0.25, 0.75, 1.0 (the supply's), chosen before any of these fits ran.
 
 Run without ``--fraction``, it prints the committed preset's cost on the fit's seeds with the chambers starting at
 each fraction, nothing refitted (about 1 min): the tenth refit's, committed when it ran
 (``twin/plants/data/tenth_refit.json``, digest 1c2dcd8c9f7f, so a later refit does not move what it prints). With
-``--fraction`` it fits (5-8 min on 2 cores), prints the fitted values, the cost and its noise, the members, the
+``--fraction`` and ``--calibration`` it printed, after its fit (5-8 min on 2 cores), and prints for a kept file, the
+fitted values, the cost and its noise, the members, the
 measured cells and T1 steady-error ranges within the issue's bars on seeds 0-4 (best), then each T3 cell's value on
 the best, its band and the members' range, the stalled runs, and per member which law leads in each cell
-(``examples/trial_start_refit.py``'s report). ``--out DIR`` also writes
-the calibration file there; ``--calibration FILE`` reports a file written before without fitting again (about 1
+(``examples/trial_start_refit.py``'s report). ``--calibration FILE`` reports a file written before (about 1
 min), after checking by its ``code_version`` (which hashes the presets as they ran) that it was fitted at that
 fraction, and first runs the measured cells again on its best values to show they give the file's table; with
 ``--validate DIR`` as well it runs ``twin validate --out DIR`` on that file, the chambers starting at that fraction,
@@ -31,7 +33,6 @@ tests/experiments/test_trials.py holds the printed numbers of the kept files. (T
 pressure was corrected after the fits, on a review: the fits had recorded the committed "half the supply".)
 
     python examples/trial_start_pressure_refit.py
-    python examples/trial_start_pressure_refit.py --fraction F [--out DIR] [--workers N]
     python examples/trial_start_pressure_refit.py --fraction F --calibration FILE [--workers N]
     python examples/trial_start_pressure_refit.py --fraction F --calibration FILE --validate DIR [--workers N]
 """
@@ -49,9 +50,9 @@ from twin.plants import as_built
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling trials, however this one is loaded
 from trial_air_box import validate_on  # noqa: E402
-from trial_start_refit import checked_file, fitted_or_read, refit_arguments, report  # noqa: E402
+from trial_start_refit import checked_file, read, refit_arguments, report  # noqa: E402
 
-COMMITTED_FRACTION = 0.5  # what every fit assumed until the eleventh refit (as_built.BEFORE_FITTED)
+TENTH_FRACTION = as_built.BEFORE_FITTED["initial_pressure_fraction"]  # 0.5: every fit's until the eleventh refit
 FRACTIONS = (0.0, 0.25, 0.5, 0.75, 1.0)  # of the supply (gauge), in both chambers at the start
 
 
@@ -59,8 +60,10 @@ FRACTIONS = (0.0, 0.25, 0.5, 0.75, 1.0)  # of the supply (gauge), in both chambe
 def chambers_starting_at(fraction: float):
     """Inside the block (and in every process forked in it) the trial's calibration files, fitted when the start
     pressure was not a fitted value (file version 8), are read with their chambers starting at ``fraction`` of the
-    supply, the value they were fitted at; after it, as before. (Until the eleventh refit the block set the start of
-    every as-built plant, which then had none of its own: the fits ran so.)"""
+    supply, the value they were fitted at; after it, as before. The files' fitted values have no start of their own,
+    so each process fills it in when it builds a plant: every pool that runs them must be made inside the block (as
+    here), or it would run them at half the supply. (Until the eleventh refit the block set the start of every
+    as-built plant, which then had none of its own: the fits ran so.)"""
     before = as_built.BEFORE_FITTED
     as_built.BEFORE_FITTED = {**before, "initial_pressure_fraction": fraction}
     try:
@@ -109,14 +112,9 @@ def main(argv: list[str] | None = None) -> None:
         return
     if not 0.0 <= args.fraction <= 1.0:
         parser.error(f"--fraction must be within 0-1 of the supply, got {args.fraction:g}")
-    if not args.calibration:
-        parser.error("the trial's fits ran on the code before the start pressure was fitted (commit 3e13ceb); since "
-                     "the eleventh refit twin calibrate fits it, so a fit here would not hold the fraction: report a "
-                     "kept file with --calibration")
-    print(f"both chambers start at {args.fraction:g} of the supply (committed: {COMMITTED_FRACTION:g})")
+    print(f"both chambers start at {args.fraction:g} of the supply (the tenth refit's: {TENTH_FRACTION:g})")
     with chambers_starting_at(args.fraction):
-        data = fitted_or_read(parser, args, f"with the chambers at {args.fraction:g} of the supply",
-                              f"fraction_{args.fraction:g}.json")
+        data = read(parser, args.calibration, f"with the chambers at {args.fraction:g} of the supply", args.workers)
         ends(data)
         report(data, args.workers)
 

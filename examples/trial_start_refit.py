@@ -8,10 +8,13 @@ Run without ``--start``, this script shows how much, on the committed preset wit
 refit's, committed when it ran: ``twin/plants/data/tenth_refit.json``, digest 1c2dcd8c9f7f, so a later refit does
 not move what it prints): the six vertical T1 cells (FF + PVA and sliding mode, 0, 6.5 and 13.5 g) from each start
 of UNFITTED_STARTS_DEG, seeds 0-4, against the measured means (about 20 s). T3 does not read this start (it starts
-at 80 deg), so the T3 cells do not depend on it directly; they may through the fit. This script measures that: it
-sets the start (``trajectories.START``, before the fit's workers fork, so they inherit it) and runs the calibration
-exactly as ``twin calibrate`` does (the same box, seeds, budgets, profiles and second start), then the T3
-prediction's twelve cells on every member of the refitted ensemble, seeds 0-4, as ``twin validate`` runs them.
+at 80 deg), so the T3 cells do not depend on it directly; they may through the fit. This script measured that on
+2026-11-27: it set the start (``trajectories.START``, before the fit's workers fork, so they inherit it) and ran the
+calibration exactly as ``twin calibrate`` did then (file version 8: the same box, seeds, budgets, profiles and
+second start), then the T3 prediction's twelve cells on every member of the refitted ensemble, seeds 0-4, as
+``twin validate`` runs them. Since the eleventh refit (2026-11-28) ``twin calibrate`` also fits the chambers' start
+pressure and starts from six earlier fits made from 30 deg, so a fit here would be another trial: the script no
+longer fits (the fits need commit 3e13ceb) and reports the kept files.
 Starts tried: 20 deg (T3's own lowest angle: the rig may have run T1 over T3's 20-140 deg, where the thesis's Hall
 sensor is linear, §5; for the twin it is below the Coulomb fit, which is clamped there, and where its model of the
 sensor's calibration errs most), 25 deg and 40 deg, then 22 deg (after seeing the others).
@@ -27,7 +30,6 @@ seen. The fit takes 5.5-7 min on 2 cores (331-399 s on 2026-11-27). The result i
 tests/experiments/test_trials.py holds the printed numbers of the kept files.
 
     python examples/trial_start_refit.py
-    python examples/trial_start_refit.py --start DEG [--out DIR] [--workers N]
     python examples/trial_start_refit.py --start DEG --calibration FILE [--workers N]
 """
 
@@ -38,7 +40,6 @@ import contextlib
 import json
 import math
 import pathlib
-import sys
 
 import numpy as np
 
@@ -91,15 +92,6 @@ def unfitted() -> None:
         print(f"from {start:g} deg: " + " / ".join(f"{m:.2f}" for m in means), flush=True)
 
 
-def fit(workers: int) -> calibrate.Calibration:
-    """``twin calibrate``'s fit, with its progress on stderr."""
-    def progress(done, total, stage, cost, values):
-        shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
-        print(f"[{done}/{total}] {stage:8} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
-
-    return calibrate.calibrate(workers=workers, progress=progress)
-
-
 def recomputed(data: dict, workers: int) -> None:
     """Run the measured cells again on ``data``'s best values and check seeds, at the start in force, and print
     whether they give the file's residual table: the check that the start reaches the evaluator's forked workers
@@ -149,41 +141,32 @@ def checked_file(parser: argparse.ArgumentParser, path: pathlib.Path, setting: s
     return data
 
 
-def fitted_or_read(parser: argparse.ArgumentParser, args: argparse.Namespace, setting: str, name: str) -> dict:
-    """Inside the block that sets a trial's condition (``setting``, as "from 20 deg"): the file
-    ``args.calibration``, once its ``code_version`` shows it was fitted so and its measured cells run again
-    (:func:`recomputed`); otherwise a fresh fit, written as ``name`` in ``args.out`` when given."""
-    if args.calibration:
-        data = checked_file(parser, args.calibration, setting)
-        recomputed(data, args.workers)
-        return data
-    result = fit(args.workers)
-    data = calibrate.record(result)
-    print(f"the fit: {result.wall_time:.0f} s")
-    if args.out:
-        args.out.mkdir(parents=True, exist_ok=True)
-        print(f"wrote {calibrate.write(data, args.out, name)}")
+def read(parser: argparse.ArgumentParser, path: pathlib.Path, setting: str, workers: int) -> dict:
+    """Inside the block that sets a trial's condition (``setting``, as "from 20 deg"): the kept file ``path``, once its
+    ``code_version`` shows it was fitted so and its measured cells run again (:func:`recomputed`)."""
+    data = checked_file(parser, path, setting)
+    recomputed(data, workers)
     return data
 
 
 def refit_arguments(doc: str, flag: str, help: str, folder: str, argv: list[str] | None,
                     extra=None) -> tuple[argparse.ArgumentParser, argparse.Namespace]:
     """A refit trial's command line: ``--FLAG`` (a number: the trial's condition; none: its unrefitted table),
-    ``--out``, ``--calibration`` (a file written before in ``folder``, at the same condition) and ``--workers``;
-    ``extra(parser)`` adds a trial's own."""
+    ``--calibration`` (a file written before in ``folder``, at the same condition; the trials no longer fit) and
+    ``--workers``; ``extra(parser)`` adds a trial's own."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument(f"--{flag}", type=float, help=help)
-    parser.add_argument("--out", type=pathlib.Path, help="write the trial's calibration file here")
-    parser.add_argument("--calibration", type=pathlib.Path, help="skip the fit: report a trial calibration file "
-                        f"written before at the same {flag} ({folder})")
+    parser.add_argument("--calibration", type=pathlib.Path, help="report a trial calibration file written before at "
+                        f"the same {flag} ({folder}); needed with --{flag}: the trials no longer fit")
     parser.add_argument("--workers", type=int, default=2)
     if extra is not None:
         extra(parser)
     args = parser.parse_args(argv)
-    if args.calibration and args.out:
-        parser.error("--calibration reports a file written before; it writes nothing (no --out)")
-    if getattr(args, flag) is None and (args.calibration or args.out):
-        parser.error(f"--calibration and --out need --{flag}")
+    if getattr(args, flag) is None and args.calibration:
+        parser.error(f"--calibration needs --{flag}")
+    if getattr(args, flag) is not None and not args.calibration:
+        parser.error("the trial's fits ran on twin calibrate as it was before the start pressure was fitted (commit "
+                     "3e13ceb); a fit now would be another trial: report a kept file with --calibration")
     return parser, args
 
 
@@ -195,7 +178,7 @@ def main(argv: list[str] | None = None) -> None:
         return
     print(f"T1, T2 and T4 from {args.start:g} deg (committed: {COMMITTED_START_DEG:g})")
     with started_at(args.start):
-        report(fitted_or_read(parser, args, f"from {args.start:g} deg", f"start_{args.start:g}.json"), args.workers)
+        report(read(parser, args.calibration, f"from {args.start:g} deg", args.workers), args.workers)
 
 
 if __name__ == "__main__":

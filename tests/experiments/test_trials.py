@@ -358,7 +358,7 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
     assert "was not fitted with the chambers at 0.5 of the supply with these presets" in capsys.readouterr().err
     assert printed == {
         "0": [
-            'both chambers start at 0 of the supply (committed: 0.5)',
+            "both chambers start at 0 of the supply (the tenth refit's: 0.5)",
             "the measured cells run again from this start: 17 of 21 within 20 %, each mean as the file's: True",
             'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 11 of 13',
             'fitted: stiction 1.844, air_fraction 0.04277, ccw_coulomb_scale 1.144, leak_conductance 1.604e-14, load_friction 0.3, observer_gain 480.1',
@@ -380,7 +380,7 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS FFFFFS SSSSSS SSSFSS SSSSSS SSSSSS FSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
         ],
         "0.25": [
-            'both chambers start at 0.25 of the supply (committed: 0.5)',
+            "both chambers start at 0.25 of the supply (the tenth refit's: 0.5)",
             "the measured cells run again from this start: 16 of 21 within 20 %, each mean as the file's: True",
             'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 11 of 13',
             'fitted: stiction 1.395, air_fraction 0.052, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515',
@@ -402,7 +402,7 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
         ],
         "0.75": [
-            'both chambers start at 0.75 of the supply (committed: 0.5)',
+            "both chambers start at 0.75 of the supply (the tenth refit's: 0.5)",
             "the measured cells run again from this start: 17 of 21 within 20 %, each mean as the file's: True",
             'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 8 of 13',
             'fitted: stiction 1.789, air_fraction 0.04, ccw_coulomb_scale 1, leak_conductance 1.725e-14, load_friction 0.3, observer_gain 515',
@@ -424,7 +424,7 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
         ],
         "1": [
-            'both chambers start at 1 of the supply (committed: 0.5)',
+            "both chambers start at 1 of the supply (the tenth refit's: 0.5)",
             "the measured cells run again from this start: 16 of 21 within 20 %, each mean as the file's: True",
             'T1 steady-error ranges within ±0.5 deg on seeds 0-4 (best): 11 of 13',
             'fitted: stiction 1.587, air_fraction 0.04573, ccw_coulomb_scale 1.145, leak_conductance 1.715e-14, load_friction 0.15, observer_gain 499.5',
@@ -448,12 +448,13 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
     }
 
 
-def test_trial_start_pressure_refit_fits_no_more(capsys):
-    """Its fits ran before the start pressure was fitted; twin calibrate now fits it, so a fit at a fixed fraction
-    would not hold it: refused, pointing to the commit they ran on."""
-    trial = _load("trial_start_pressure_refit")
+@pytest.mark.parametrize(("name", "flag"), [("trial_start_pressure_refit", "--fraction"), ("trial_start_refit", "--start")])
+def test_the_refit_trials_fit_no_more(capsys, name, flag):
+    """Their fits ran before the start pressure was fitted; twin calibrate now fits it and starts from earlier fits,
+    so a fit now would be another trial: refused, pointing to the commit they ran on (their kept files still report)."""
+    trial = _load(name)
     with pytest.raises(SystemExit):
-        trial.main(["--fraction", "0.5"])
+        trial.main([flag, "0.5"])
     assert "before the start pressure was fitted (commit 3e13ceb)" in capsys.readouterr().err
 
 
@@ -842,6 +843,11 @@ def test_trial_air_box_writes_the_file_twin_calibrate_would_with_its_box(monkeyp
     assert written["bounds"] == kept["bounds"] and written["bounds"]["air_fraction"]["high"] == 0.08
     assert written["made_by"].startswith(kept["made_by"].split(";")[0]) and "air_fraction" in written["made_by"]
     assert (calibrate.FITTED, calibrate.PROFILED) == before and calibrate.FITTED != trial.trial_box()  # put back
+    # the start pressure it ran with is stated (not fitted then), and the committed assumptions are as they were
+    assert written["assumed"]["initial_pressure_fraction"].startswith("both chambers start at half the supply")
+    from twin.plants import as_built
+
+    assert "initial_pressure_fraction" not in as_built.ASSUMED
 
 
 def test_the_ninth_refit_kept_for_the_trials_is_the_preset_the_docs_quote_them_on():

@@ -188,8 +188,8 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
     section = text[text.index("## Prediction: Chapter 6 T3 (blind)"):]
     assert ("T3 as the twin runs it: 80 ± 60 deg at 0.5 Hz for 4 s, starting mid-stroke at full speed" in section
             and "at a supply of 300 kPa, Chapter 5's;" in section
-            and "Of these the band includes only the chambers' start pressure" in section
-            and "it does not include the uncertainty of the others" in section)
+            and "Of these only the chambers' start pressure is fitted, so only its spread" in section
+            and "The prediction does not include the uncertainty of the others" in section)
     fitted = round(calibrated_values()["initial_pressure_fraction"] * 100)
     starts = [round(m["initial_pressure_fraction"] * 100) for m in ensemble_values()]
     assert (f"fitted on the measured cells with T1, T2 and T4 run from 30 deg, and with what both chambers held when "
@@ -198,7 +198,7 @@ def test_report_says_t3_and_its_supply_as_the_twin_runs_them(monkeypatch):
             and "nor what the chambers held when a run began" in section)
     opening = text[text.index("## In short"):text.index("## Summary")]
     assert "- **Blind T3 prediction**" in opening and "not over the other choices the thesis leaves open" in opening
-    assert "(among them what the chambers held when a run began)" in opening
+    assert "(among them what the chambers held when a run began, which the members' range holds more of)" in opening
     assert "(T3's length and start, the supply, where T1, T2 and T4 started)" in opening
     for trial in ("trial_t2_t3_choices", "trial_chapter6_supply", "trial_start_refit", "trial_start_pressure_refit"):
         assert f"`examples/{trial}.py`" in section
@@ -1185,3 +1185,20 @@ def test_prediction_names_the_fitted_values_no_member_varies(monkeypatch):
     leak_only = validate._fixed_text([member, dict(member, air_fraction=0.03)])
     assert leak_only.startswith("Every member has the same leak 1.39 x 1e-14 m^3/(Pa s): the fit does not profile it")
     assert "whatif" not in leak_only  # the pointer is the air's
+
+
+def test_the_prediction_section_says_the_start_pressure_was_not_fitted_on_a_file_from_before(monkeypatch):
+    """On a calibration file from before the eleventh refit (version 8: the start pressure held at half the supply),
+    the report says so and that the band holds none of the open choices; on the committed file, that it was fitted."""
+    import twin.plants
+    from twin.plants import as_built
+
+    section = validate.report(_fake(1.0, lag_within=True, stalled=0))
+    assert "fitted with the rest" in section and "of the supply, not fitted" not in section
+    tenth = as_built.as_built_plant(as_built.calibrated_values(as_built.TENTH_REFIT_FILE))
+    monkeypatch.setattr(as_built, "CALIBRATION_FILE", as_built.TENTH_REFIT_FILE)
+    monkeypatch.setattr(twin.plants, "plant", lambda name: tenth)
+    text = validate.report(_fake(1.0, lag_within=True, stalled=0))
+    assert "and with both chambers starting at 50 % of the supply, not fitted." in text
+    assert "The band does not include the uncertainty of any of them" in text
+    assert "(T3's length and start, the supply, where T1, T2 and T4 started, what the chambers held when a run began)" in text

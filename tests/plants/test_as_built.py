@@ -701,3 +701,31 @@ def test_calibration_cost_line_reads_the_committed_file_and_refuses_a_broken_one
         path.write_text(json.dumps(broken))
         with pytest.raises(InvalidScenario, match=f"^cannot read the as-built calibration .*c.json: .*{words}"):
             calibration_cost_line(path)
+
+
+def test_the_start_pressure_is_fitted_since_version_9_and_older_files_read_as_they_were_fitted(tmp_path):
+    """A file of version 8 or earlier has no start pressure among its fitted values: it was fitted with both chambers
+    at half the supply, and is read so (its plants unchanged); a file of version 9 must give it. A misspelt or unknown
+    parameter is an error, not a silent default; the start lies between the tank's pressure and the supply's."""
+    import json
+
+    from twin.exceptions import InvalidParameter
+    from twin.plants import as_built
+
+    tenth = json.loads(as_built.TENTH_REFIT_FILE.read_text())
+    assert tenth["version"] == 8 and "initial_pressure_fraction" not in tenth["fitted"]
+    assert as_built.calibrated_values(as_built.TENTH_REFIT_FILE)["initial_pressure_fraction"] == 0.5
+    assert not as_built.fits_start_pressure(as_built.TENTH_REFIT_FILE) and as_built.fits_start_pressure()
+    assert (as_built.as_built_params(tenth["fitted"])[0]
+            == as_built.as_built_params(as_built.calibrated_values(as_built.TENTH_REFIT_FILE))[0])
+    moved = as_built.as_built_params(dict(tenth["fitted"], initial_pressure_fraction=0.25))[0]
+    assert moved.chambers.initial_pressure_fraction == 0.25
+    newer = tmp_path / "as_built.json"
+    newer.write_text(json.dumps(dict(tenth, version=9)))
+    with pytest.raises(InvalidScenario, match="initial_pressure_fraction"):
+        as_built.calibrated_values(newer)
+    with pytest.raises(InvalidScenario, match=r"unknown as-built parameters \['initial_pressure_frac'\]"):
+        as_built.as_built_params(dict(tenth["fitted"], initial_pressure_frac=0.25))
+    for outside in (-0.1, 1.2):
+        with pytest.raises(InvalidParameter, match="initial_pressure_fraction must be in"):
+            ChamberParams(initial_pressure_fraction=outside)

@@ -91,8 +91,8 @@ ENSEMBLE_MAX = 1 + 2 * len(PROFILED)  # the best and each profiled parameter's t
 FILE_VERSION = 9  # 4: the solenoid valve, §9's T1 cells, the ensemble and the noise; 5: the load friction;
 # 6: the observer gain; 7: the CCW scale's top from §4.5.1's slowest full-duty speed, and profiled;
 # 8: the air's box 0-8 % and profiled, and the second start (previous_fits); 9: the chambers' start pressure
-# fitted and profiled, five further starts, the starts evaluated before the noise and the profiles
-# The second start: the ninth refit's fitted values (file version 7, 2026-11-26;
+# fitted and profiled, six further starts, evaluated before the noise and the profiles
+# File version 8's second start: the ninth refit's fitted values (file version 7, 2026-11-26;
 # twin.plants.as_built.NINTH_REFIT_FILE), the best of the same search with the air's box 0-3 %. They cost 0.5587 on
 # the fit seeds; the search with the box at 0-8 % settles at 4.6 % air for 0.5367, with a noise of 0.139, and its
 # profiles alone put no set with less than 3.98 % air in the ensemble (its 2 % point costs 0.83). Added 2026-11-27,
@@ -521,7 +521,7 @@ def record(result: Calibration) -> dict:
         "targets": [dataclasses.asdict(t) for t in TARGETS],
         "fitted": dict(result.values),  # full precision: the preset is exactly what was scored
         "bounds": {f.name: {"low": f.low, "high": f.high, "unit": f.unit, "why": f.why} for f in FITTED},
-        "assumed": ASSUMED,
+        "assumed": dict(ASSUMED),  # a copy: the file keeps what held when it was written
         "cost": result.cost,
         "noise": {"how": "the best values after the further starts, before the profiles: their cost on the fit seeds and on each further seed set "
                          "of the same size; noise = their sample std; the ensemble is every evaluated set with "

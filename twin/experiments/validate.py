@@ -94,11 +94,11 @@ def _profiled(members: Sequence[dict]) -> list[str]:
 
 
 def _start_pressure_fitted() -> bool:
-    """Whether the calibration fits the chambers' start pressure (since the eleventh refit; a trial reading an older
-    file puts the box it ran on in place, ``twin.plants.as_built.FITTED`` as it is when asked)."""
+    """Whether the calibration the report runs on (``twin.plants.as_built.CALIBRATION_FILE`` as it is when asked, so
+    a trial's file in its place counts) fitted the chambers' start pressure: its file version says so."""
     from twin.plants import as_built
 
-    return "initial_pressure_fraction" in {f.name for f in as_built.FITTED}
+    return as_built.fits_start_pressure()
 
 
 def _t3_as_run_text() -> str:
@@ -132,8 +132,9 @@ def _t3_as_run_text() -> str:
             f"measured cells with T1, T2 and T4 run from {math.degrees(t1.start):g} deg, {chambers}. The thesis "
             "states neither T3's length nor its start nor where T1, T2 and T4 started nor what the chambers held when a "
             "run began, nor restates the supply for Chapter 6. "
-            + ("Of these the band includes only the chambers' start pressure, as far as the measured cells leave it "
-               "open (the spread over the fitted parameters); it does not include the uncertainty of the others, "
+            + ("Of these only the chambers' start pressure is fitted, so only its spread, as far as the measured "
+               "cells leave it open, is in the prediction: in the members' range, and less of it in the 10-90 % band, "
+               "which leaves the extreme members out. The prediction does not include the uncertainty of the others, "
                "which it holds as said." if fitted else
                "The band does not include the uncertainty of any of them: it is the spread over the fitted parameters "
                "with these held.")
@@ -1721,9 +1722,10 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
                         + (f". Across the ensemble: {members_text}" if members_text else "") + ". " if both else "")
                      + ("No run of any ensemble member stalls." if not stalls else
                         f"{counted(stalls, 'run')} of the ensemble's members stall{'s' if stalls == 1 else ''}.")
-                     + (" The band is the spread over the fitted parameters only (among them what the chambers held "
-                        "when a run began), not over the other choices the thesis leaves open (T3's length and start, "
-                        "the supply, where T1, T2 and T4 started), which the prediction section names."
+                     + (" The band and the members' range are the spread over the fitted parameters only (among them "
+                        "what the chambers held when a run began, which the members' range holds more of), not over "
+                        "the other choices the thesis leaves open (T3's length and start, the supply, where T1, T2 and "
+                        "T4 started), which the prediction section names."
                         if _start_pressure_fitted() else
                         " The band is the spread over the fitted parameters only, not over the choices the thesis "
                         "leaves open (T3's length and start, the supply, where T1, T2 and T4 started, what the "

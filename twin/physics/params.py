@@ -269,8 +269,8 @@ class ChamberParams:
     air_fraction: float = 0.0  # x_air: free air volume per chamber volume at atmospheric pressure (calibrated)
     dead_volume: float = 0.3e-6  # m^3 per chamber at the end of stroke: ports, hose to the valves (*assumed*)
     leak_conductance: float = 0.0  # m^3/(Pa s) past each discharge valve to the tank: a closed chamber relaxes
-    initial_pressure_fraction: float = 0.5  # of the supply, in both chambers at the start (*assumed*: the
-    # thesis pre-charges by moving the joint side to side; shut valves then trap a middle pressure)
+    initial_pressure_fraction: float = 0.5  # gauge, of the supply, in both chambers at the start: the thesis does not
+    # say; the as-built plant fits it (twin.plants.as_built.FITTED; assumed half the supply until 2026-11-28)
     atmospheric_pressure: float = 101.325e3  # Pa
     substeps: int = 100  # implicit sub-steps of the chamber/rack/supply model per physics tick (10 us)
 
@@ -280,6 +280,9 @@ class ChamberParams:
             raise InvalidParameter(f"air_fraction must be in [0, {AIR_FRACTION_MAX}], got {self.air_fraction}")
         if self.leak_conductance < 0 or self.substeps < 1:
             raise InvalidParameter("leak_conductance must be >= 0 and substeps >= 1")
+        if not 0.0 <= self.initial_pressure_fraction <= 1.0:  # between the tank's pressure and the supply's
+            raise InvalidParameter(f"initial_pressure_fraction must be in [0, 1] of the supply, got "
+                                   f"{self.initial_pressure_fraction}")
 
 
 @dataclasses.dataclass(frozen=True)

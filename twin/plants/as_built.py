@@ -57,7 +57,7 @@ EFFECTS = ("compressibility", "supply_line", "stiction", "ccw_friction", "load_f
            "hall_calibration", "experiment_gains", "sensor_metrics")
 CALIBRATION_FILE = importlib.resources.files("twin.plants") / "data" / "as_built.json"  # package data
 # The ninth refit's calibration file (committed 2026-11-26 to 2026-11-27, digest 57ff10bf5b36), kept as it was:
-# the trials that ran on it read it, and `twin calibrate` starts a second time from its fitted values.
+# the trials that ran on it read it, and `twin calibrate` starts from its fitted values too (one of its further starts).
 NINTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "ninth_refit.json"
 # The tenth refit's calibration file (committed 2026-11-27 to 2026-11-28, digest 1c2dcd8c9f7f), kept as it was: the
 # trials that ran on it read it, and `twin calibrate` starts from its fitted values too.
@@ -190,6 +190,13 @@ def _checked(values: object, path: pathlib.Path, what: str, version: object = No
     return out
 
 
+def fits_start_pressure(path: pathlib.Path | None = None) -> bool:
+    """Whether the calibration in ``path`` (the committed one by default) fitted the chambers' start pressure: a
+    file of version 9 on (the eleventh refit's); an older one was fitted with it at :data:`BEFORE_FITTED`'s value."""
+    version = _record(_file(path)).get("version")
+    return isinstance(version, int) and version >= FIRST_VERSION_FITTING["initial_pressure_fraction"]
+
+
 def calibrated_values(path: pathlib.Path | None = None) -> dict[str, float]:
     """The fitted values from ``path`` (the committed calibration by default)."""
     path = _file(path)
@@ -237,6 +244,10 @@ def as_built_params(values: dict[str, float], *, without: Iterable[str] = ()) ->
     """Joint parameters with the fitted ``values``, minus the effects named in ``without``;
     also the plant options (gain set, scoring) those effects set. Values from a fit made before one of them was
     fitted (a file's ``fitted`` as it was written) take it as :data:`BEFORE_FITTED`, as that fit did."""
+    unknown = set(values) - {f.name for f in FITTED}
+    if unknown:
+        raise InvalidScenario(f"unknown as-built parameters {sorted(unknown)}: the fitted ones are "
+                              f"{', '.join(f.name for f in FITTED)}")
     values = {**BEFORE_FITTED, **values}
     off = set(without)
     unknown = off - set(EFFECTS)
@@ -295,6 +306,7 @@ def preset_digest(path: pathlib.Path | None = None) -> str:
     return hashlib.sha256(repr(plants).encode()).hexdigest()[:12]
 
 
-__all__ = ["ASSUMED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "FITTED",
+__all__ = ["ASSUMED", "BEFORE_FITTED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "FITTED",
            "FULL_DUTY_SPEED_DIGIT", "FULL_DUTY_WINDOW", "SLOWEST_FULL_DUTY_SPEED", "STICTION_SCATTER",
-           "as_built_params", "as_built_plant", "calibrated_values", "calibration_cost_line", "ensemble_costs", "ensemble_plants", "ensemble_values", "preset_digest"]
+           "as_built_params", "as_built_plant", "calibrated_values", "calibration_cost_line", "ensemble_costs", "ensemble_plants", "ensemble_values", "fits_start_pressure",
+           "preset_digest"]
