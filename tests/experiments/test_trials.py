@@ -456,6 +456,19 @@ def test_the_refit_trials_fit_no_more(capsys, name, flag):
     with pytest.raises(SystemExit):
         trial.main([flag, "0.5"])
     assert "before the start pressure was fitted (commit 3e13ceb)" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as stop:  # nothing to write: --out is gone
+        trial.main([flag, "0.5", "--calibration", "x.json", "--out", "y"])
+    assert stop.value.code == 2 and "unrecognized arguments: --out y" in capsys.readouterr().err
+
+
+def test_trial_air_box_refuses_a_box_that_would_misplace_calibrates_parameters(monkeypatch):
+    """calibrate's parameter places are built once from the whole box: the trial's box must be its first ones."""
+    from twin.experiments import calibrate
+
+    trial = _load("trial_air_box")
+    monkeypatch.setattr(calibrate, "FITTED", calibrate.FITTED[::-1])  # the start pressure first: dropping it moves all
+    with pytest.raises(AssertionError, match="not the committed one's first parameters"):
+        trial.trial_box()
 
 
 @pytest.mark.slow  # about 1 min: §8's eleven cells, ten seeds, nine ways (the plain runs and eight delays)

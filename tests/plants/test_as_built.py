@@ -724,6 +724,7 @@ def test_the_start_pressure_is_fitted_since_version_9_and_older_files_read_as_th
     newer.write_text(json.dumps(dict(tenth, version=9)))
     with pytest.raises(InvalidScenario, match="initial_pressure_fraction"):
         as_built.calibrated_values(newer)
+    assert not as_built.fits_start_pressure(newer)  # as a trial that left it out of its box would write
     with pytest.raises(InvalidScenario, match=r"unknown as-built parameters \['initial_pressure_frac'\]"):
         as_built.as_built_params(dict(tenth["fitted"], initial_pressure_frac=0.25))
     for outside in (-0.1, 1.2):

@@ -192,9 +192,12 @@ def _checked(values: object, path: pathlib.Path, what: str, version: object = No
 
 def fits_start_pressure(path: pathlib.Path | None = None) -> bool:
     """Whether the calibration in ``path`` (the committed one by default) fitted the chambers' start pressure: a
-    file of version 9 on (the eleventh refit's); an older one was fitted with it at :data:`BEFORE_FITTED`'s value."""
-    version = _record(_file(path)).get("version")
-    return isinstance(version, int) and version >= FIRST_VERSION_FITTING["initial_pressure_fraction"]
+    file of version 9 on (the eleventh refit's) that gives it among its fitted values; an older one was fitted with
+    it at :data:`BEFORE_FITTED`'s value, and so was a trial's file that left it out of its box."""
+    record = _record(_file(path))
+    version, fitted = record.get("version"), record.get("fitted")
+    return (isinstance(version, int) and version >= FIRST_VERSION_FITTING["initial_pressure_fraction"]
+            and isinstance(fitted, dict) and "initial_pressure_fraction" in fitted)
 
 
 def calibrated_values(path: pathlib.Path | None = None) -> dict[str, float]:
