@@ -29,7 +29,6 @@ docs/investigations.md.
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import math
 
 import numpy as np
@@ -55,11 +54,8 @@ NAMES = {"pva": "PVA", "ffpva": "FF+PVA", "smc": "SMC"}
 def plant_starting_at(fraction: float | None):
     """The committed (tenth refit's) as-built plant, its chambers starting at ``fraction`` of the supply (None: as
     it is)."""
-    plant = as_built_plant(calibrated_values(TENTH_REFIT_FILE))
-    if fraction is None:
-        return plant
-    chambers = dataclasses.replace(plant.params.chambers, initial_pressure_fraction=fraction)
-    return dataclasses.replace(plant, params=dataclasses.replace(plant.params, chambers=chambers))
+    values = calibrated_values(TENTH_REFIT_FILE)
+    return as_built_plant(values if fraction is None else {**values, "initial_pressure_fraction": fraction})
 
 
 def cells(fraction: float | None, seeds: range, keys=None, held: float = 0.0) -> list[tuple[list[float], list[float]]]:

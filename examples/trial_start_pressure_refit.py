@@ -102,7 +102,7 @@ def main(argv: list[str] | None = None) -> None:
                                        "--calibration: run `twin validate --out DIR` on that file, the chambers "
                                        "starting at that fraction, instead of the report"))
     if args.validate:
-        if args.fraction is None or not args.calibration:
+        if not args.calibration:  # refit_arguments: --calibration and --fraction come together
             parser.error("--validate needs --fraction and --calibration FILE")
         with chambers_starting_at(args.fraction):
             checked_file(parser, args.calibration, f"with the chambers at {args.fraction:g} of the supply")

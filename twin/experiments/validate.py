@@ -46,7 +46,13 @@ from twin.experiments.reference import (
     THESIS_FULL_DUTY_SPEEDS,
     THESIS_SIMULATED_RMSE_DEG,
 )
-from twin.plants.as_built import CCW_SCALE_BOUND, FITTED, FULL_DUTY_SPEED_DIGIT, FULL_DUTY_WINDOW
+from twin.plants.as_built import (
+    CCW_SCALE_BOUND,
+    FITTED,
+    FULL_DUTY_SPEED_DIGIT,
+    FULL_DUTY_WINDOW,
+    fits_start_pressure,
+)
 from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS
 from viz.figures import plt
@@ -93,14 +99,6 @@ def _profiled(members: Sequence[dict]) -> list[str]:
             + [n for n in carried if n not in calibrate.PROFILED and len({m[n] for m in members}) > 1])
 
 
-def _start_pressure_fitted() -> bool:
-    """Whether the calibration the report runs on (``twin.plants.as_built.CALIBRATION_FILE`` as it is when asked, so
-    a trial's file in its place counts) fitted the chambers' start pressure: its file version says so."""
-    from twin.plants import as_built
-
-    return as_built.fits_start_pressure()
-
-
 def _t3_as_run_text() -> str:
     """Sentences on the T3 cells as the twin runs them: T3 (``twin.physics.trajectories``; its middle, amplitude
     and length, which SPEC §7 does not fix all of), the supply pressure (the as-built plant's, which §9 does not
@@ -112,11 +110,12 @@ def _t3_as_run_text() -> str:
     start pressure fitted, and said so, since 2026-11-28 (stop 43)."""
     from twin.physics.params import NOMINAL_PARAMS
     from twin.physics.trajectories import trajectory
-    from twin.plants import as_built, plant
+    from twin.plants import plant
+    from twin.plants.as_built import ensemble_plants
 
     params = plant("as-built").params
-    starts = [p.params.chambers.initial_pressure_fraction * 100 for p in as_built.ensemble_plants()]
-    fitted = _start_pressure_fitted()
+    fitted = fits_start_pressure()  # the file the report runs on (a trial's in the committed one's place counts)
+    starts = [p.params.chambers.initial_pressure_fraction * 100 for p in ensemble_plants()] if fitted else []
     chambers = (f"and with what both chambers held when a run began fitted with the rest: "
                 f"{params.chambers.initial_pressure_fraction * 100:.0f} % of the supply on the committed preset, "
                 f"{min(starts):.0f}-{max(starts):.0f} % over the ensemble" if fitted else
@@ -1726,7 +1725,7 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
                         "what the chambers held when a run began, which the members' range holds more of), not over "
                         "the other choices the thesis leaves open (T3's length and start, the supply, where T1, T2 and "
                         "T4 started), which the prediction section names."
-                        if _start_pressure_fitted() else
+                        if fits_start_pressure() else
                         " The band is the spread over the fitted parameters only, not over the choices the thesis "
                         "leaves open (T3's length and start, the supply, where T1, T2 and T4 started, what the "
                         "chambers held when a run began), which the prediction section names."))
