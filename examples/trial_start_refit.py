@@ -12,25 +12,32 @@ at 80 deg), so the T3 cells do not depend on it directly; they may through the f
 2026-11-27: it set the start (``trajectories.START``, before the fit's workers fork, so they inherit it) and ran the
 calibration exactly as ``twin calibrate`` did then (file version 8: the same box, seeds, budgets, profiles and
 second start), then the T3 prediction's twelve cells on every member of the refitted ensemble, seeds 0-4, as
-``twin validate`` runs them. Since the eleventh refit (2026-11-28) ``twin calibrate`` also fits the chambers' start
-pressure and starts from six earlier fits made from 30 deg, so a fit here would be another trial: the script no
-longer fits (the fits need commit 3e13ceb) and reports the kept files.
-Starts tried: 20 deg (T3's own lowest angle: the rig may have run T1 over T3's 20-140 deg, where the thesis's Hall
-sensor is linear, §5; for the twin it is below the Coulomb fit, which is clamped there, and where its model of the
-sensor's calibration errs most), 25 deg and 40 deg, then 22 deg (after seeing the others).
+``twin validate`` runs them. Starts tried: 20 deg (T3's own lowest angle: the rig may have run T1 over T3's 20-140
+deg, where the thesis's Hall sensor is linear, §5; for the twin it is below the Coulomb fit, which is clamped there,
+and where its model of the sensor's calibration errs most), 25 deg and 40 deg, then 22 deg (after seeing the others).
+Those files are ``examples/trial_start_refit/start_*.json``.
+
+On 2026-11-28 (stop 44) it fitted again from the same four starts with ``twin calibrate`` as the eleventh refit made
+it (file version 9: the chambers' start pressure fitted too, six earlier fits as further starts; ``--out``), to see
+whether the start still moves the prediction once the start pressure is fitted:
+``examples/trial_start_refit/eleventh_start_*.json``, each fit 306-330 s on 2 cores, alone. ``--from-committed``
+prints its best's cost on the further seed sets (10-39) from its own start, then runs each member of such a file
+from the committed start (30 deg) against the committed preset's cut (its cost
+plus its noise) and, for a member under it, prints its cost on the further seed sets and its 13.5 g vertical T3
+cells: whether the committed ensemble left out a set that fits as well from the committed start (one did).
 
 It prints the fitted values, the cost and its noise, the members, the measured cells within 20 % on seeds 0-4,
 and each T3 cell's value on the best, its band and the members' range, the stalled runs, and per member which
-law leads in each cell. ``--out DIR`` also writes the calibration file there; ``--calibration FILE`` reports a
-file written before without fitting again (about 1 min), with the start it was fitted at (checked by its
-``code_version``, which hashes the trajectories as they ran), and first runs the measured cells again on its best
-values to show they give the file's table from that start. The files of
-2026-11-27 are in ``examples/trial_start_refit/``. Nothing is installed, and the T3 cells' measurements were not
-seen. The fit takes 5.5-7 min on 2 cores (331-399 s on 2026-11-27). The result is recorded in docs/prediction.md; a slow test in
-tests/experiments/test_trials.py holds the printed numbers of the kept files.
+law leads in each cell. ``--out DIR`` fits now (``twin calibrate``'s code as it is) and writes the calibration file
+there; ``--calibration FILE`` reports a file written before without fitting again (under a minute), with the start it
+was fitted at (checked by its ``code_version``, which hashes the trajectories as they ran), and first runs the
+measured cells again on its best values to show they give the file's table from that start. Nothing is installed,
+and the T3 cells' measurements were not seen. The results are recorded in docs/prediction.md and
+docs/investigations.md; a slow test in tests/experiments/test_trials.py holds the printed numbers of the kept files.
 
     python examples/trial_start_refit.py
-    python examples/trial_start_refit.py --start DEG --calibration FILE [--workers N]
+    python examples/trial_start_refit.py --start DEG --calibration FILE [--from-committed] [--workers N]
+    python examples/trial_start_refit.py --start DEG --out DIR [--from-committed] [--workers N]
 """
 
 from __future__ import annotations
@@ -40,6 +47,7 @@ import contextlib
 import json
 import math
 import pathlib
+import sys
 
 import numpy as np
 
@@ -50,7 +58,13 @@ from twin.experiments.reference import THESIS_ROBUSTNESS_T1_DEG
 from twin.experiments.validate import PREDICTION_CELLS, SEEDS, member_means, prediction_rows, rmse_within
 from twin.physics import trajectories
 from twin.physics.model import Orientation
-from twin.plants.as_built import TENTH_REFIT_FILE, as_built_plant, calibrated_values
+from twin.plants.as_built import (
+    TENTH_REFIT_FILE,
+    as_built_plant,
+    calibrated_values,
+    calibration_cost_line,
+    preset_digest,
+)
 from twin.sim.scenario import Scenario
 
 COMMITTED_START_DEG = 30.0
@@ -131,6 +145,45 @@ def report(data: dict, workers: int) -> None:
           + " ".join(leads))
 
 
+def own_further(data: dict, workers: int) -> None:
+    """The calibration ``data``'s best values on the further seed sets, at the start in force (its own): the costs
+    to set beside the committed preset's on the same seeds, which no fit's search saw."""
+    with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
+        costs = [calibrate.cost(evaluator.cells(data["fitted"], seeds=s)) for s in calibrate.NOISE_SEED_SETS]
+    print("its best on seeds 10-19 / 20-29 / 30-39, from this start: " + " / ".join(f"{c:.3f}" for c in costs))
+
+
+def from_committed(data: dict, workers: int) -> None:
+    """Run every member of the calibration ``data`` (fitted from another start) from the committed start, on the fit
+    seeds, against the committed preset's cut (its cost plus its noise: the rule that admits a member). For each
+    member under the cut: its cost on the further seed sets beside the committed preset's best, and its 13.5 g
+    vertical T3 cells (seeds 0-4; T3 starts at 80 deg whatever T1's start) and which law leads in how many cells.
+    Call it with T1, T2 and T4 at the committed start."""
+    best, noise = calibration_cost_line()
+    committed = calibrated_values()
+    print(f"its members from {COMMITTED_START_DEG:g} deg, fit seeds, against the committed preset's cut {best + noise:.4f} "
+          f"(cost {best:.4f} + noise {noise:.4f}; preset {preset_digest()}):")
+    cells = [(law, g, o) for law, _, g, o in PREDICTION_CELLS]
+    with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
+        further = None
+        for index, member in enumerate(data["ensemble"]):
+            cost = calibrate.cost(evaluator.cells(member["values"]))
+            if cost > best + noise:
+                print(f"  member {index}: cost {cost:.4f}")
+                continue
+            if further is None:  # the committed preset's best on the further seed sets, once
+                further = [calibrate.cost(evaluator.cells(committed, seeds=s)) for s in calibrate.NOISE_SEED_SETS]
+            own = [calibrate.cost(evaluator.cells(member["values"], seeds=s)) for s in calibrate.NOISE_SEED_SETS]
+            t3 = dict(zip(cells, (c.mean_rmse for c in evaluator.cells(member["values"], keys=PREDICTION_CELLS,
+                                                                         seeds=SEEDS)), strict=True))
+            ahead = sum(t3["smc", g, o] < t3["ffpva", g, o] for law, g, o in cells if law == "ffpva")
+            print(f"  member {index}: cost {cost:.4f}, under the cut; seeds 10-19 / 20-29 / 30-39 "
+                  + " / ".join(f"{c:.3f}" for c in own) + " (the committed preset " + " / ".join(f"{c:.3f}" for c in further)
+                  + f"); T3 13.5 g vertical {t3['ffpva', 13.5, 'vertical']:.2f} / {t3['smc', 13.5, 'vertical']:.2f} "
+                  f"(FF + PVA / sliding mode), sliding mode ahead in {ahead} of 6 cells; "
+                  + ", ".join(f"{k} {v:.4g}" for k, v in member["values"].items()), flush=True)
+
+
 def checked_file(parser: argparse.ArgumentParser, path: pathlib.Path, setting: str) -> dict:
     """The calibration file ``path``, refused (a parser error) unless its ``code_version`` shows it was fitted with
     the presets, trajectories and MJCF in force (inside the block that sets the trial's condition, ``setting``)."""
@@ -150,35 +203,73 @@ def read(parser: argparse.ArgumentParser, path: pathlib.Path, setting: str, work
 
 
 def refit_arguments(doc: str, flag: str, help: str, folder: str, argv: list[str] | None,
-                    extra=None) -> tuple[argparse.ArgumentParser, argparse.Namespace]:
+                    extra=None, fits: bool = False) -> tuple[argparse.ArgumentParser, argparse.Namespace]:
     """A refit trial's command line: ``--FLAG`` (a number: the trial's condition; none: its unrefitted table),
-    ``--calibration`` (a file written before in ``folder``, at the same condition; the trials no longer fit) and
-    ``--workers``; ``extra(parser)`` adds a trial's own."""
+    ``--calibration`` (a file written before in ``folder``, at the same condition), ``--out`` when the trial
+    ``fits`` (a fit now, on ``twin calibrate`` as it is) and ``--workers``; ``extra(parser)`` adds a trial's own."""
     parser = argparse.ArgumentParser(description=doc.splitlines()[0])
     parser.add_argument(f"--{flag}", type=float, help=help)
     parser.add_argument("--calibration", type=pathlib.Path, help="report a trial calibration file written before at "
-                        f"the same {flag} ({folder}); needed with --{flag}: the trials no longer fit")
+                        f"the same {flag} ({folder})" + ("" if fits else f"; needed with --{flag}: the trial no "
+                                                         "longer fits"))
+    if fits:
+        parser.add_argument("--out", type=pathlib.Path, metavar="DIR", help=f"fit at --{flag} on twin calibrate as "
+                            "it is now, write the file into DIR (created), then report it")
     parser.add_argument("--workers", type=int, default=2)
     if extra is not None:
         extra(parser)
     args = parser.parse_args(argv)
-    if getattr(args, flag) is None and args.calibration:
-        parser.error(f"--calibration needs --{flag}")
-    if getattr(args, flag) is not None and not args.calibration:
+    out = getattr(args, "out", None)
+    if getattr(args, flag) is None and (args.calibration or out):
+        parser.error(f"--{'calibration' if args.calibration else 'out'} needs --{flag}")
+    if args.calibration and out:
+        parser.error("--calibration reports a file written before and --out fits a new one: give one of them")
+    if getattr(args, flag) is not None and not (args.calibration or out):
+        if fits:
+            parser.error(f"--{flag} needs --out DIR (a fit now, about 6 min on 2 cores) or --calibration FILE")
         parser.error("the trial's fits ran on twin calibrate as it was before the start pressure was fitted (commit "
                      "3e13ceb); a fit now would be another trial: report a kept file with --calibration")
     return parser, args
 
 
+def fitted_here(out: pathlib.Path, name: str, workers: int) -> dict:
+    """A fit now, with ``twin calibrate``'s code as it is, written to ``out/name`` (whole or not at all) and
+    returned; progress on stderr as ``twin calibrate`` prints it."""
+    def progress(done: int, total: int, stage: str, cost: float, values: dict) -> None:
+        print(f"[{done}/{total}] {stage:7} cost {cost:.4f}", file=sys.stderr, flush=True)
+
+    out.mkdir(parents=True, exist_ok=True)
+    data = calibrate.record(calibrate.calibrate(workers=workers, progress=progress))
+    print(f"wrote {calibrate.write(data, out, name)} (file version {data['version']}, {data['wall_time_s']:.0f} s)")
+    return data
+
+
 def main(argv: list[str] | None = None) -> None:
+    def committed_flag(parser: argparse.ArgumentParser) -> None:
+        parser.add_argument("--from-committed", action="store_true", help="then run the file's members from the "
+                            f"committed start ({COMMITTED_START_DEG:g} deg) against the committed preset's cut")
+
     parser, args = refit_arguments(__doc__, "start", "where T1, T2 and T4 start, deg (none: the unrefitted table)",
-                                   "examples/trial_start_refit/", argv)
+                                   "examples/trial_start_refit/", argv, extra=committed_flag, fits=True)
+    if args.from_committed and args.start is None:
+        parser.error("--from-committed needs --start and a fit (--out or --calibration)")
+    if args.start is not None and not 0.0 <= args.start <= UNFITTED_STARTS_DEG[-1]:
+        parser.error(f"--start {args.start:g}: T1, T2 and T4 must start within 0-{UNFITTED_STARTS_DEG[-1]:g} deg (their "
+                     "+120 deg must end inside the Coulomb fit, 174 deg at most)")
     if args.start is None:
         unfitted()
         return
     print(f"T1, T2 and T4 from {args.start:g} deg (committed: {COMMITTED_START_DEG:g})")
     with started_at(args.start):
-        report(read(parser, args.calibration, f"from {args.start:g} deg", args.workers), args.workers)
+        if args.out:
+            data = fitted_here(args.out, f"eleventh_start_{args.start:g}.json", args.workers)
+        else:
+            data = read(parser, args.calibration, f"from {args.start:g} deg", args.workers)
+        report(data, args.workers)
+        if args.from_committed:
+            own_further(data, args.workers)
+    if args.from_committed:  # T1, T2 and T4 back at the committed start: the Evaluator's workers fork with it
+        from_committed(data, args.workers)
 
 
 if __name__ == "__main__":

@@ -327,6 +327,161 @@ def test_trial_start_refit_reports_what_prediction_md_quotes(capsys):
     }
 
 
+@pytest.mark.slow  # about 9 min on 2 cores: four kept files' reports, their members from 30 deg, further seeds
+def test_trial_start_refit_on_the_eleventh_code_reports_what_the_docs_quote(capsys):
+    """The trial calibrations fitted on 2026-11-28 (stop 44) with twin calibrate as the eleventh refit made it, T1, T2
+    and T4 from 20, 22, 25 and 40 deg, reported again with --from-committed, give what docs/investigations.md,
+    docs/prediction.md, docs/as-built.md and the README quote: each file's own table from its start, its T3 cells,
+    its best on the further seed sets, and its members run from the committed start against the committed preset's
+    cut (member 11 of the fit from 25 deg under it, at 4.10 / 3.82 deg on the 13.5 g vertical T3 cells). The trial
+    puts the committed start back."""
+    from twin.physics import trajectories
+
+    trial, folder, committed = _load("trial_start_refit"), ROOT / "examples" / "trial_start_refit", trajectories.START
+    printed = {}
+    for start in ("20", "22", "25", "40"):
+        trial.main(["--start", start, "--calibration", str(folder / f"eleventh_start_{start}.json"), "--from-committed",
+                    "--workers", "2"])
+        printed[start] = capsys.readouterr().out.splitlines()
+    assert trajectories.START == committed
+    assert printed == {
+        "20": [
+            'T1, T2 and T4 from 20 deg (committed: 30)',
+            "the measured cells run again from this start: 15 of 21 within 20 %, each mean as the file's: True",
+            'fitted: stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 1',
+            'cost 0.6134, noise 0.1605; 71 evaluations; 13 members',
+            'measured cells within 20 % on seeds 0-4 (best): 15 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.35  2.30-2.39  2.29-2.39  0',
+            '  ffpva   6.5 g horizontal 2.63  2.51-2.63  2.49-2.71  0',
+            '  ffpva  13.5 g horizontal 2.79  2.71-2.84  2.70-2.93  0',
+            '  ffpva     0 g vertical   2.42  2.29-2.42  2.25-2.42  0',
+            '  ffpva   6.5 g vertical   2.62  2.54-2.64  2.53-2.64  0',
+            '  ffpva  13.5 g vertical   3.51  3.50-3.79  3.49-4.22  0',
+            '  smc       0 g horizontal 2.23  2.21-2.27  2.17-2.29  0',
+            '  smc     6.5 g horizontal 2.37  2.31-2.42  2.30-2.43  0',
+            '  smc    13.5 g horizontal 2.57  2.52-2.66  2.48-2.70  0',
+            '  smc       0 g vertical   2.18  2.20-2.30  2.18-2.31  0',
+            '  smc     6.5 g vertical   2.49  2.42-2.49  2.41-2.49  0',
+            '  smc    13.5 g vertical   3.41  3.40-3.51  3.37-3.95  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSFSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+            'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.703 / 0.735 / 0.623',
+            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            '  member 0: cost 0.6586',
+            '  member 1: cost 0.7159',
+            '  member 2: cost 0.6860',
+            '  member 3: cost 0.6962',
+            '  member 4: cost 0.5961, under the cut; seeds 10-19 / 20-29 / 30-39 0.813 / 0.765 / 0.850 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.81 / 3.52 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.572, air_fraction 0.04441, ccw_coulomb_scale 1.149, leak_conductance 1.665e-14, load_friction 0.3331, observer_gain 473.4, initial_pressure_fraction 0.5551',
+            '  member 5: cost 0.6297, under the cut; seeds 10-19 / 20-29 / 30-39 0.835 / 0.812 / 0.759 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.61 / 3.45 (FF + PVA / sliding mode), sliding mode ahead in 5 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
+            '  member 6: cost 0.6342, under the cut; seeds 10-19 / 20-29 / 30-39 0.821 / 0.843 / 0.863 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.60 / 3.42 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.269, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
+            '  member 7: cost 0.6136, under the cut; seeds 10-19 / 20-29 / 30-39 0.814 / 0.796 / 0.762 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.67 / 3.46 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.766, air_fraction 0.03764, ccw_coulomb_scale 1.139, leak_conductance 1.591e-14, load_friction 0.3182, observer_gain 497.6, initial_pressure_fraction 0.5304',
+            '  member 8: cost 0.6080, under the cut; seeds 10-19 / 20-29 / 30-39 0.782 / 0.746 / 0.711 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.56 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.25',
+            '  member 9: cost 0.6609',
+            '  member 10: cost 0.5852, under the cut; seeds 10-19 / 20-29 / 30-39 0.831 / 0.771 / 0.924 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.49 / 3.44 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.75',
+            '  member 11: cost 0.6307, under the cut; seeds 10-19 / 20-29 / 30-39 0.830 / 0.850 / 0.839 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.60 / 3.37 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.202, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
+            '  member 12: cost 0.6212, under the cut; seeds 10-19 / 20-29 / 30-39 0.802 / 0.880 / 0.805 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.66 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.067, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
+        ],
+        "22": [
+            'T1, T2 and T4 from 22 deg (committed: 30)',
+            "the measured cells run again from this start: 18 of 21 within 20 %, each mean as the file's: True",
+            'fitted: stiction 1.996, air_fraction 0.03375, ccw_coulomb_scale 1.134, leak_conductance 2.786e-14, load_friction 0.3449, observer_gain 581.2, initial_pressure_fraction 0.7899',
+            'cost 0.6053, noise 0.0790; 77 evaluations; 8 members',
+            'measured cells within 20 % on seeds 0-4 (best): 18 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.45  2.39-2.47  2.38-2.47  0',
+            '  ffpva   6.5 g horizontal 2.60  2.59-2.65  2.57-2.65  0',
+            '  ffpva  13.5 g horizontal 2.77  2.76-2.82  2.73-2.84  0',
+            '  ffpva     0 g vertical   2.42  2.36-2.47  2.36-2.47  0',
+            '  ffpva   6.5 g vertical   2.68  2.60-2.67  2.56-2.68  0',
+            '  ffpva  13.5 g vertical   4.03  3.99-4.05  3.97-4.06  0',
+            '  smc       0 g horizontal 2.23  2.22-2.29  2.22-2.29  0',
+            '  smc     6.5 g horizontal 2.49  2.45-2.51  2.44-2.51  0',
+            '  smc    13.5 g horizontal 2.62  2.62-2.67  2.60-2.71  0',
+            '  smc       0 g vertical   2.22  2.21-2.26  2.20-2.27  0',
+            '  smc     6.5 g vertical   2.50  2.50-2.56  2.48-2.57  0',
+            '  smc    13.5 g vertical   3.82  3.71-3.82  3.70-3.82  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+            'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.805 / 0.794 / 0.838',
+            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            '  member 0: cost 0.8592',
+            '  member 1: cost 0.8883',
+            '  member 2: cost 0.9107',
+            '  member 3: cost 0.8702',
+            '  member 4: cost 1.1093',
+            '  member 5: cost 0.8937',
+            '  member 6: cost 0.8738',
+            '  member 7: cost 0.8329',
+        ],
+        "25": [
+            'T1, T2 and T4 from 25 deg (committed: 30)',
+            "the measured cells run again from this start: 17 of 21 within 20 %, each mean as the file's: True",
+            'fitted: stiction 1.92, air_fraction 0.03428, ccw_coulomb_scale 1.269, leak_conductance 2.832e-14, load_friction 0.3648, observer_gain 559.6, initial_pressure_fraction 0.7421',
+            'cost 0.5463, noise 0.0843; 77 evaluations; 13 members',
+            'measured cells within 20 % on seeds 0-4 (best): 17 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.45  2.38-2.45  2.38-2.52  0',
+            '  ffpva   6.5 g horizontal 2.54  2.54-2.63  2.51-2.72  0',
+            '  ffpva  13.5 g horizontal 2.82  2.76-2.85  2.71-2.88  0',
+            '  ffpva     0 g vertical   2.38  2.38-2.46  2.36-2.51  0',
+            '  ffpva   6.5 g vertical   2.61  2.60-2.69  2.58-2.69  0',
+            '  ffpva  13.5 g vertical   4.08  4.01-4.19  3.95-4.38  0',
+            '  smc       0 g horizontal 2.27  2.23-2.32  2.21-2.43  0',
+            '  smc     6.5 g horizontal 2.59  2.44-2.59  2.43-2.80  0',
+            '  smc    13.5 g horizontal 2.73  2.61-2.72  2.55-2.98  0',
+            '  smc       0 g vertical   2.25  2.22-2.31  2.21-2.47  0',
+            '  smc     6.5 g vertical   2.53  2.50-2.60  2.49-2.81  0',
+            '  smc    13.5 g vertical   3.81  3.76-3.98  3.70-4.24  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SFSSSS SSSSSS SSSSSS SSSSSS SFFFFS SSSSSS SSSSFS SFSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
+            'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.754 / 0.575 / 0.771',
+            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            '  member 0: cost 0.6919',
+            '  member 1: cost 0.8883',
+            '  member 2: cost 0.6665',
+            '  member 3: cost 0.7002',
+            '  member 4: cost 0.6849',
+            '  member 5: cost 0.6759',
+            '  member 6: cost 0.6556',
+            '  member 7: cost 0.6614',
+            '  member 8: cost 0.6903',
+            '  member 9: cost 0.6556',
+            '  member 10: cost 0.6506',
+            '  member 11: cost 0.5638, under the cut; seeds 10-19 / 20-29 / 30-39 0.744 / 0.666 / 0.673 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 4.10 / 3.82 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.789, air_fraction 0.03428, ccw_coulomb_scale 1.114, leak_conductance 2.832e-14, load_friction 0.3648, observer_gain 559.6, initial_pressure_fraction 0.7421',
+            '  member 12: cost 0.6420, under the cut; seeds 10-19 / 20-29 / 30-39 0.796 / 0.645 / 0.766 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.95 / 3.76 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.877, air_fraction 0.03375, ccw_coulomb_scale 1.127, leak_conductance 2.786e-14, load_friction 0.3449, observer_gain 581.2, initial_pressure_fraction 0.7899',
+        ],
+        "40": [
+            'T1, T2 and T4 from 40 deg (committed: 30)',
+            "the measured cells run again from this start: 15 of 21 within 20 %, each mean as the file's: True",
+            'fitted: stiction 1.594, air_fraction 0.04, ccw_coulomb_scale 1.269, leak_conductance 1.067e-14, load_friction 0.236, observer_gain 410.5, initial_pressure_fraction 0.9978',
+            'cost 0.6080, noise 0.0644; 76 evaluations; 8 members',
+            'measured cells within 20 % on seeds 0-4 (best): 15 of 21',
+            'T3 (mean RMSE deg, seeds 0-4): cell, best, band p10-p90, members lowest-highest, stalled runs',
+            '  ffpva     0 g horizontal 2.29  2.21-2.32  2.21-2.39  0',
+            '  ffpva   6.5 g horizontal 2.58  2.43-2.60  2.38-2.66  0',
+            '  ffpva  13.5 g horizontal 2.85  2.64-2.89  2.63-2.99  0',
+            '  ffpva     0 g vertical   2.26  2.23-2.30  2.22-2.33  0',
+            '  ffpva   6.5 g vertical   2.61  2.47-2.65  2.41-2.74  0',
+            '  ffpva  13.5 g vertical   3.37  3.31-3.49  3.24-3.74  0',
+            '  smc       0 g horizontal 2.22  2.21-2.33  2.19-2.36  0',
+            '  smc     6.5 g horizontal 2.43  2.41-2.59  2.40-2.62  0',
+            '  smc    13.5 g horizontal 2.66  2.62-2.88  2.61-2.90  0',
+            '  smc       0 g vertical   2.21  2.22-2.35  2.21-2.36  0',
+            '  smc     6.5 g vertical   2.46  2.44-2.65  2.44-2.65  0',
+            '  smc    13.5 g vertical   3.12  3.11-3.42  3.11-3.43  0',
+            'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SFFFFF FFFFFS FFFFFS SSSSSS SSSSSS FFFFFF',
+            'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.804 / 0.751 / 0.923',
+            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            '  member 0: cost 0.8203',
+            '  member 1: cost 0.5843, under the cut; seeds 10-19 / 20-29 / 30-39 0.795 / 0.789 / 0.873 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.74 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.052, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.25',
+            '  member 2: cost 0.6977',
+            '  member 3: cost 0.8667',
+            '  member 4: cost 0.8807',
+            '  member 5: cost 0.8339',
+            '  member 6: cost 0.8475',
+            '  member 7: cost 0.8267',
+        ],
+    }
+
+
 @pytest.mark.slow  # about 2 min on 2 cores: the committed preset's cost from five start pressures; 21 cells and T3 on four files
 def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
     """The committed preset's cost with the chambers starting at five fractions of the supply, nothing refitted, and
@@ -448,17 +603,76 @@ def test_trial_start_pressure_refit_reports_what_prediction_md_quotes(capsys):
     }
 
 
-@pytest.mark.parametrize(("name", "flag"), [("trial_start_pressure_refit", "--fraction"), ("trial_start_refit", "--start")])
-def test_the_refit_trials_fit_no_more(capsys, name, flag):
-    """Their fits ran before the start pressure was fitted; twin calibrate now fits it and starts from earlier fits,
-    so a fit now would be another trial: refused, pointing to the commit they ran on (their kept files still report)."""
-    trial = _load(name)
+def test_the_start_pressure_refit_trial_fits_no_more(capsys):
+    """Its fits ran before the start pressure was fitted; twin calibrate now fits it, so a fit at a fixed start
+    pressure would be another trial: refused, pointing to the commit they ran on (its kept files still report)."""
+    trial = _load("trial_start_pressure_refit")
     with pytest.raises(SystemExit):
-        trial.main([flag, "0.5"])
+        trial.main(["--fraction", "0.5"])
     assert "before the start pressure was fitted (commit 3e13ceb)" in capsys.readouterr().err
-    with pytest.raises(SystemExit) as stop:  # nothing to write: --out is gone
-        trial.main([flag, "0.5", "--calibration", "x.json", "--out", "y"])
+    with pytest.raises(SystemExit) as stop:  # nothing to write: it has no --out
+        trial.main(["--fraction", "0.5", "--calibration", "x.json", "--out", "y"])
     assert stop.value.code == 2 and "unrecognized arguments: --out y" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(("argv", "said"), [
+    (["--start", "20"], "--start needs --out DIR (a fit now, about 6 min on 2 cores) or --calibration FILE"),
+    (["--from-committed"], "--from-committed needs --start"),
+    (["--start", "55", "--out", "y"], "--start 55: T1, T2 and T4 must start within 0-54 deg"),
+    (["--start", "-1", "--calibration", "x.json"], "--start -1: T1, T2 and T4 must start within 0-54 deg"),
+    (["--start", "20", "--calibration", "x.json", "--out", "y"], "give one of them"),
+    (["--out", "y"], "--out needs --start"),
+    (["--calibration", "x.json"], "--calibration needs --start"),
+])
+def test_the_start_refit_trial_fits_with_out_or_reports_a_kept_file(capsys, monkeypatch, tmp_path, argv, said):
+    """A start needs either a fit now (--out) or a kept file (--calibration), not both and not neither, and lies where
+    T1's +120 deg stays inside the Coulomb fit. Refused before anything runs: a fit here fails the test at once."""
+    from twin.experiments import calibrate
+
+    def no_fit(**kwargs):
+        raise AssertionError("the trial started a fit")
+
+    monkeypatch.setattr(calibrate, "calibrate", no_fit)
+    monkeypatch.chdir(tmp_path)  # "y" and "x.json" are relative: nothing lands in the checkout
+    with pytest.raises(SystemExit) as stop:
+        _load("trial_start_refit").main(argv)
+    assert stop.value.code == 2 and said in capsys.readouterr().err
+
+
+@pytest.mark.slow  # about 40 s on 2 cores: one evaluation of the 21 cells on two seeds, the T3 cells on it, twice
+def test_the_start_refit_trials_fit_runs_calibrate_from_its_start_and_writes_a_file_it_reads_back(capsys, tmp_path,
+                                                                                                  monkeypatch):
+    """--out fits with twin calibrate's code as it is (cut down here to its centre point on two seeds) with T1, T2
+    and T4 from the given start, writes a version-9 file whose code version holds that start (so --calibration
+    reads it back from 20 deg and refuses it from 30) and puts the committed start back."""
+    import functools
+    import json
+    import math
+
+    from twin.experiments import calibrate
+    from twin.physics import trajectories
+
+    trial, committed, seen = _load("trial_start_refit"), trajectories.START, []
+    small = functools.partial(calibrate.calibrate, fit_seeds=(0, 1), check_seeds=(0, 1), noise_seed_sets=(),
+                              scan_points=0, simplex_evaluations=0, profile_points=0, previous=())
+
+    def fit(**kwargs):
+        seen.append(trajectories.START)  # the start in force while calibrate runs
+        return small(**kwargs)
+
+    monkeypatch.setattr(trial.calibrate, "calibrate", fit)
+    trial.main(["--start", "20", "--out", str(tmp_path / "fits"), "--workers", "2"])
+    out = capsys.readouterr().out
+    path = tmp_path / "fits" / "eleventh_start_20.json"
+    assert f"wrote {path} (file version 9," in out and "members" in out and "T3 (mean RMSE deg" in out
+    assert seen == [pytest.approx(math.radians(20.0))] and trajectories.START == committed
+    monkeypatch.undo()
+    assert json.loads(path.read_text())["version"] == calibrate.FILE_VERSION == 9
+    trial.main(["--start", "20", "--calibration", str(path), "--workers", "2"])  # read back from its own start
+    assert "each mean as the file's: True" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        trial.main(["--start", "30", "--calibration", str(path)])
+    assert "was not fitted from 30 deg with these presets" in capsys.readouterr().err
 
 
 def test_trial_air_box_refuses_a_box_that_would_misplace_calibrates_parameters(monkeypatch):

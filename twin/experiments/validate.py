@@ -1559,8 +1559,8 @@ def _why(v: Validation) -> list[str]:
                + _and_list([f"T{t}" for t in split])
                + ": it comes out right on some members and wrong on others, and the committed preset's "
                "order there is one of them, not a finding." if split else
-               "Each order is right on every member or on none: the parameters the data do not pin do not "
-               "turn it."))
+               "Each order is right on every member or on none: within the ensemble, the parameters the data "
+               "do not pin do not turn it."))
     parts = v.sliding_mode
     if parts and parts["trajectories"]:
         ts = sorted(parts["trajectories"])
@@ -1622,11 +1622,13 @@ def _why(v: Validation) -> list[str]:
                  f"({relative:.0%} of the median; 10-90 % band {widest['band_p10']:.2f}-{widest['band_p90']:.2f})"
                  + (f", from member {int(np.argmin(means[k]))} ({_member_text(lowest, differ)}) to member "
                     f"{int(np.argmax(means[k]))} ({_member_text(highest, differ)})" if differ else "")
-                 + ". So within what the data allow the T3 cells' size "
+                 + ". So within the ensemble the T3 cells' size "
                  + ("does not turn on them" if relative < RMSE_TOLERANCE else "**turns on them** there: read the "
                     "members' range, not the committed value")
-                 + (" (no run of any member stalls)." if not any(r["stalled_runs"] for r in v.prediction) else
-                    "; some members' runs stall, counted per cell above."))
+                 + " (the ensemble holds the sets the fit's search evaluated; a set it did not reach may fit as well "
+                    "and lie outside the members' range"
+                 + ("; no run of any member stalls)." if not any(r["stalled_runs"] for r in v.prediction) else
+                    "); some members' runs stall, counted per cell above."))
     text, apart = _members_lead_text(v)
     if apart:
         lines.append(f"- **Which law leads on T3 turns on which of the equally good fits holds** (the ensemble's "
