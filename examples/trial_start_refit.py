@@ -158,7 +158,9 @@ def from_committed(data: dict, workers: int) -> None:
     seeds, against the committed preset's cut (its cost plus its noise: the rule that admits a member). For each
     member under the cut: its cost on the further seed sets beside the committed preset's best, and its 13.5 g
     vertical T3 cells (seeds 0-4; T3 starts at 80 deg whatever T1's start) and which law leads in how many cells.
-    Call it with T1, T2 and T4 at the committed start."""
+    Call it with T1, T2 and T4 at the committed start. It reads the committed preset, the eleventh refit's when this
+    ran (digest 78c00bbdf7e4, printed): a later refit moves what it prints, and should keep the eleventh's file (as
+    ``twin/plants/data/tenth_refit.json`` keeps the tenth's) and point this at it."""
     best, noise = calibration_cost_line()
     committed = calibrated_values()
     print(f"its members from {COMMITTED_START_DEG:g} deg, fit seeds, against the committed preset's cut {best + noise:.4f} "
