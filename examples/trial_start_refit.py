@@ -55,7 +55,14 @@ from twin.batch.sweep import code_version
 from twin.envs.runner import run_many
 from twin.experiments import calibrate
 from twin.experiments.reference import THESIS_ROBUSTNESS_T1_DEG
-from twin.experiments.validate import PREDICTION_CELLS, SEEDS, member_means, prediction_rows, rmse_within
+from twin.experiments.validate import (
+    PREDICTION_CELLS,
+    SEEDS,
+    lead_counts,
+    member_means,
+    prediction_rows,
+    rmse_within,
+)
 from twin.physics import trajectories
 from twin.physics.model import Orientation
 from twin.plants.as_built import (
@@ -145,11 +152,16 @@ def report(data: dict, workers: int) -> None:
           + " ".join(leads))
 
 
+def further_costs(evaluator: calibrate.Evaluator, values: dict[str, float]) -> list[float]:
+    """The cost of ``values`` on each further seed set (calibrate's NOISE_SEED_SETS), at the start in force."""
+    return [calibrate.cost(evaluator.cells(values, seeds=s)) for s in calibrate.NOISE_SEED_SETS]
+
+
 def own_further(data: dict, workers: int) -> None:
     """The calibration ``data``'s best values on the further seed sets, at the start in force (its own): the costs
     to set beside the committed preset's on the same seeds, which no fit's search saw."""
     with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
-        costs = [calibrate.cost(evaluator.cells(data["fitted"], seeds=s)) for s in calibrate.NOISE_SEED_SETS]
+        costs = further_costs(evaluator, data["fitted"])
     print("its best on seeds 10-19 / 20-29 / 30-39, from this start: " + " / ".join(f"{c:.3f}" for c in costs))
 
 
@@ -165,7 +177,7 @@ def from_committed(data: dict, workers: int) -> None:
     committed = calibrated_values()
     print(f"its members from {COMMITTED_START_DEG:g} deg, fit seeds, against the committed preset's cut {best + noise:.4f} "
           f"(cost {best:.4f} + noise {noise:.4f}; preset {preset_digest()}):")
-    cells = [(law, g, o) for law, _, g, o in PREDICTION_CELLS]
+    rows = [{"controller": law, "payload_g": g, "orientation": o} for law, _, g, o in PREDICTION_CELLS]
     with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
         further = None
         for index, member in enumerate(data["ensemble"]):
@@ -174,11 +186,11 @@ def from_committed(data: dict, workers: int) -> None:
                 print(f"  member {index}: cost {cost:.4f}")
                 continue
             if further is None:  # the committed preset's best on the further seed sets, once
-                further = [calibrate.cost(evaluator.cells(committed, seeds=s)) for s in calibrate.NOISE_SEED_SETS]
-            own = [calibrate.cost(evaluator.cells(member["values"], seeds=s)) for s in calibrate.NOISE_SEED_SETS]
-            t3 = dict(zip(cells, (c.mean_rmse for c in evaluator.cells(member["values"], keys=PREDICTION_CELLS,
-                                                                         seeds=SEEDS)), strict=True))
-            ahead = sum(t3["smc", g, o] < t3["ffpva", g, o] for law, g, o in cells if law == "ffpva")
+                further = further_costs(evaluator, committed)
+            own = further_costs(evaluator, member["values"])
+            means = [c.mean_rmse for c in evaluator.cells(member["values"], keys=PREDICTION_CELLS, seeds=SEEDS)]
+            t3 = {(r["controller"], r["payload_g"], r["orientation"]): m for r, m in zip(rows, means, strict=True)}
+            ahead = lead_counts(rows, means)[0].get("smc", 0)  # validate's rule: a tie counts for neither
             print(f"  member {index}: cost {cost:.4f}, under the cut; seeds 10-19 / 20-29 / 30-39 "
                   + " / ".join(f"{c:.3f}" for c in own) + " (the committed preset " + " / ".join(f"{c:.3f}" for c in further)
                   + f"); T3 13.5 g vertical {t3['ffpva', 13.5, 'vertical']:.2f} / {t3['smc', 13.5, 'vertical']:.2f} "
