@@ -22,14 +22,16 @@ it (file version 9: the chambers' start pressure fitted too, six earlier fits as
 whether the start still moves the prediction once the start pressure is fitted:
 ``examples/trial_start_refit/eleventh_start_*.json``, each fit 306-330 s on 2 cores, alone. ``--from-committed``
 prints its best's cost on the further seed sets (10-39) from its own start, then runs each member of such a file
-from the committed start (30 deg) against the committed preset's cut (its cost
-plus its noise) and, for a member under it, prints its cost on the further seed sets and its 13.5 g vertical T3
-cells: whether the committed ensemble left out a set that fits as well from the committed start (one did).
+from the committed start (30 deg) against the eleventh refit's cut (its cost
+plus its noise; the twelfth's is the same) and, for a member under it, prints its cost on the further seed sets and its 13.5 g vertical T3
+cells: whether the eleventh refit's ensemble left out a set that fits as well from the committed start (one did; the
+twelfth refit takes the ten sets under the cut as further starts: ``twin/plants/data/start_angle_refits.json``).
 
 It prints the fitted values, the cost and its noise, the members, the measured cells within 20 % on seeds 0-4,
 and each T3 cell's value on the best, its band and the members' range, the stalled runs, and per member which
 law leads in each cell. ``--out DIR`` fits now (``twin calibrate``'s code as it is) and writes the calibration file
-there; ``--calibration FILE`` reports a file written before without fitting again (under a minute), with the start it
+there as ``versionN_start_DEG.json`` (N: that code's file version; the kept ``eleventh_start_*`` files are version 9),
+refusing a file of that name already there; ``--calibration FILE`` reports a file written before without fitting again (under a minute), with the start it
 was fitted at (checked by its ``code_version``, which hashes the trajectories as they ran), and first runs the
 measured cells again on its best values to show they give the file's table from that start. Nothing is installed,
 and the T3 cells' measurements were not seen. The results are recorded in docs/prediction.md and
@@ -66,6 +68,7 @@ from twin.experiments.validate import (
 from twin.physics import trajectories
 from twin.physics.model import Orientation
 from twin.plants.as_built import (
+    ELEVENTH_REFIT_FILE,
     TENTH_REFIT_FILE,
     as_built_plant,
     calibrated_values,
@@ -167,16 +170,15 @@ def own_further(data: dict, workers: int) -> None:
 
 def from_committed(data: dict, workers: int) -> None:
     """Run every member of the calibration ``data`` (fitted from another start) from the committed start, on the fit
-    seeds, against the committed preset's cut (its cost plus its noise: the rule that admits a member). For each
-    member under the cut: its cost on the further seed sets beside the committed preset's best, and its 13.5 g
+    seeds, against the eleventh refit's cut (its cost plus its noise: the rule that admits a member). For each
+    member under the cut: its cost on the further seed sets beside the eleventh refit's best, and its 13.5 g
     vertical T3 cells (seeds 0-4; T3 starts at 80 deg whatever T1's start) and which law leads in how many cells.
-    Call it with T1, T2 and T4 at the committed start. It reads the committed preset, the eleventh refit's when this
-    ran (digest 78c00bbdf7e4, printed): a later refit moves what it prints, and should keep the eleventh's file (as
-    ``twin/plants/data/tenth_refit.json`` keeps the tenth's) and point this at it."""
-    best, noise = calibration_cost_line()
-    committed = calibrated_values()
-    print(f"its members from {COMMITTED_START_DEG:g} deg, fit seeds, against the committed preset's cut {best + noise:.4f} "
-          f"(cost {best:.4f} + noise {noise:.4f}; preset {preset_digest()}):")
+    Call it with T1, T2 and T4 at the committed start. It reads the eleventh refit's kept file (digest 78c00bbdf7e4,
+    printed), the committed preset when it first ran; the twelfth refit has the same best, noise and cut."""
+    best, noise = calibration_cost_line(ELEVENTH_REFIT_FILE)
+    committed = calibrated_values(ELEVENTH_REFIT_FILE)
+    print(f"its members from {COMMITTED_START_DEG:g} deg, fit seeds, against the eleventh refit's cut {best + noise:.4f} "
+          f"(cost {best:.4f} + noise {noise:.4f}; preset {preset_digest(ELEVENTH_REFIT_FILE)}):")
     rows = [{"controller": law, "payload_g": g, "orientation": o} for law, _, g, o in PREDICTION_CELLS]
     with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
         further = None
@@ -185,14 +187,14 @@ def from_committed(data: dict, workers: int) -> None:
             if cost > best + noise:
                 print(f"  member {index}: cost {cost:.4f}")
                 continue
-            if further is None:  # the committed preset's best on the further seed sets, once
+            if further is None:  # the eleventh refit's best on the further seed sets, once
                 further = further_costs(evaluator, committed)
             own = further_costs(evaluator, member["values"])
             means = [c.mean_rmse for c in evaluator.cells(member["values"], keys=PREDICTION_CELLS, seeds=SEEDS)]
             t3 = {(r["controller"], r["payload_g"], r["orientation"]): m for r, m in zip(rows, means, strict=True)}
             ahead = lead_counts(rows, means)[0].get("smc", 0)  # validate's rule: a tie counts for neither
             print(f"  member {index}: cost {cost:.4f}, under the cut; seeds 10-19 / 20-29 / 30-39 "
-                  + " / ".join(f"{c:.3f}" for c in own) + " (the committed preset " + " / ".join(f"{c:.3f}" for c in further)
+                  + " / ".join(f"{c:.3f}" for c in own) + " (the eleventh refit's best " + " / ".join(f"{c:.3f}" for c in further)
                   + f"); T3 13.5 g vertical {t3['ffpva', 13.5, 'vertical']:.2f} / {t3['smc', 13.5, 'vertical']:.2f} "
                   f"(FF + PVA / sliding mode), sliding mode ahead in {ahead} of 6 cells; "
                   + ", ".join(f"{k} {v:.4g}" for k, v in member["values"].items()), flush=True)
@@ -261,7 +263,7 @@ def fitted_here(out: pathlib.Path, name: str, workers: int) -> dict:
 def main(argv: list[str] | None = None) -> None:
     def committed_flag(parser: argparse.ArgumentParser) -> None:
         parser.add_argument("--from-committed", action="store_true", help="then run the file's members from the "
-                            f"committed start ({COMMITTED_START_DEG:g} deg) against the committed preset's cut")
+                            f"committed start ({COMMITTED_START_DEG:g} deg) against the eleventh refit's cut")
 
     parser, args = refit_arguments(__doc__, "start", "where T1, T2 and T4 start, deg (none: the unrefitted table)",
                                    "examples/trial_start_refit/", argv, extra=committed_flag, fits=True)
@@ -273,10 +275,13 @@ def main(argv: list[str] | None = None) -> None:
     if args.start is None:
         unfitted()
         return
+    name = f"version{calibrate.FILE_VERSION}_start_{args.start:g}.json"  # the kept files, version 9: eleventh_start_*
+    if args.out and (args.out / name).exists():
+        parser.error(f"{args.out / name} is there already: a fit would replace it; give another --out")
     print(f"T1, T2 and T4 from {args.start:g} deg (committed: {COMMITTED_START_DEG:g})")
     with started_at(args.start):
         if args.out:
-            data = fitted_here(args.out, f"eleventh_start_{args.start:g}.json", args.workers)
+            data = fitted_here(args.out, name, args.workers)
         else:
             data = read(parser, args.calibration, f"from {args.start:g} deg", args.workers)
         report(data, args.workers)

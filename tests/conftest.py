@@ -8,6 +8,7 @@ import io
 import math
 import os
 import pathlib
+import signal
 import subprocess
 import sys
 
@@ -52,6 +53,19 @@ def open_loop(duty, *, plant: str | Plant = "thesis", trajectory: int = 1, paylo
 
 def deg(x: float) -> float:
     return math.degrees(x)
+
+
+@pytest.fixture
+def ctrl_c_as_in_a_terminal():
+    """SIGINT raising KeyboardInterrupt for the test, as in a terminal, whatever started pytest: a background job
+    of a non-interactive shell (``cmd &`` in a script) starts with SIGINT ignored, Python then leaves it ignored,
+    and `twin` rightly keeps an ignored SIGINT ignored (as under ``nohup``), so a test sending one would see
+    nothing. Put back afterwards."""
+    before = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, before)
 
 
 @pytest.fixture

@@ -1217,7 +1217,7 @@ class _StopInsideDel:
 
 @pytest.mark.parametrize("signum", [signal.SIGINT, signal.SIGTERM], ids=["ctrl-c", "sigterm"])
 def test_a_stop_python_swallowed_during_a_run_still_stops_it_before_its_outputs(tmp_path, capsys, monkeypatch,
-                                                                                 signum):
+                                                                                 signum, ctrl_c_as_in_a_terminal):
     """A Ctrl-C or SIGTERM that landed inside a garbage collector's callback during `twin run` (2 in 8 tries at
     one moment) was swallowed: the run wrote its outputs and exited 0, the stop lost. Now it is raised again
     before the outputs go into place: exit 130, nothing written, and the unraisable hook put back."""
@@ -1339,7 +1339,8 @@ def test_the_probes_last_inputs_are_refused(tmp_path, capsys, monkeypatch, argv,
     assert list(tmp_path.iterdir()) == []
 
 
-def test_a_stop_python_swallowed_during_a_sweep_stops_it_after_the_batch_it_came_in(tmp_path, capsys, monkeypatch):
+def test_a_stop_python_swallowed_during_a_sweep_stops_it_after_the_batch_it_came_in(tmp_path, capsys, monkeypatch,
+                                                                                  ctrl_c_as_in_a_terminal):
     """In a sweep, a swallowed stop is raised again once the batch it came in is stored: the sweep stops as on
     Ctrl-C (exit 130, the finished batch kept for a resume), instead of running every batch."""
     from twin.batch import sweep
@@ -1362,7 +1363,7 @@ def test_a_stop_python_swallowed_during_a_sweep_stops_it_after_the_batch_it_came
         store.close()
 
 
-def test_a_swallowed_stop_outlives_an_inner_block_that_ends_first():
+def test_a_swallowed_stop_outlives_an_inner_block_that_ends_first(ctrl_c_as_in_a_terminal):
     """A command nests the keeping of swallowed stops (``main`` and its output folder each keep them): the inner
     block's end must not forget a stop the outer block has yet to raise (a review caught the first version)."""
     from twin.batch.stops import raise_if_stopped, swallowed_stops_kept

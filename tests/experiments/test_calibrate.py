@@ -188,8 +188,17 @@ def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_on
         assert fit["assumed"]["initial_pressure_fraction"].startswith(f"both chambers start at {fraction:g} of")
         assert start["cost"] == fit["cost"]
         trials.append({**fit["fitted"], "initial_pressure_fraction": fraction})
+    angles = []  # the start-angle trial's members under the eleventh refit's cut from 30 deg, at their exact values
+    for start in json.loads(calibrate.START_ANGLE_REFITS_FILE.read_text())["starts"]:
+        source = ROOT / start["source"]
+        assert hashlib.sha256(source.read_bytes()).hexdigest() == start["source_sha256"]
+        member = json.loads(source.read_text())["ensemble"][start["member"]]
+        assert start["values"] == member["values"] and start["cost_from_30_deg"] <= 0.5239 + 0.1229
+        angles.append(member["values"])
+    assert [(s["source"][-7:-5], s["member"]) for s in json.loads(calibrate.START_ANGLE_REFITS_FILE.read_text())[
+        "starts"]] == [*(("20", m) for m in (4, 5, 6, 7, 8, 10, 11, 12)), ("25", 11), ("25", 12)]
     half = {"initial_pressure_fraction": 0.5}
-    assert calibrate.previous_fits() == ({**ninth["fitted"], **half}, {**tenth["fitted"], **half}, *trials)
+    assert calibrate.previous_fits() == ({**ninth["fitted"], **half}, {**tenth["fitted"], **half}, *trials, *angles)
     box = {f.name: f for f in FITTED}
     assert all(box[n].low <= v <= box[n].high for start in calibrate.previous_fits() for n, v in start.items())
     assert box["air_fraction"].high == 0.08 and ninth["bounds"]["air_fraction"]["high"] == 0.03
@@ -204,25 +213,48 @@ def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_on
         calibrate.calibrate(workers=1, previous=[dict(ninth["fitted"], extra=1.0)])
 
 
-def test_the_committed_file_holds_the_further_starts_as_evaluated_and_as_members():
-    """The eleventh refit's file: its six "previous" rows, after the simplex and before the profiles, are the further
-    starts at exactly their values, each costing what its own file says (to 1e-12: machines differ in the last
-    bits), within the noise, so each is a member; made_by says so, and the file is of this version."""
+def test_the_committed_file_holds_the_further_starts_as_evaluated_and_its_ensemble_by_the_rule():
+    """The twelfth refit's file: its sixteen "previous" rows, after the simplex and before the profiles, are the
+    further starts at exactly their values. The six earlier fits each cost what its own file says (to 1e-12: machines
+    differ in the last bits) and are members; the ten start-angle sets cost what the trial printed (4 digits), all
+    within the noise. The ensemble is the rule's choice from the whole history (so which of the ten are members is the
+    rule's, not picked by hand); made_by says so, and the file is of this version."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     from twin.plants.as_built import NINTH_REFIT_FILE, TENTH_REFIT_FILE
 
     stages = [h["stage"] for h in committed["history"]]
     rows = [h for h in committed["history"] if h["stage"] == "previous"]
     first = stages.index("previous")
-    assert stages[first:first + 6] == ["previous"] * 6 and "simplex" not in stages[first:] and "profile" not in stages[:first]
+    assert stages[first:first + 16] == ["previous"] * 16 and "simplex" not in stages[first:] and "profile" not in stages[:first]
     assert [r["values"] for r in rows] == list(calibrate.previous_fits())
     kept = [json.loads(f.read_text())["cost"] for f in (NINTH_REFIT_FILE, TENTH_REFIT_FILE)] + [
         t["cost"] for t in json.loads(calibrate.START_PRESSURE_REFITS_FILE.read_text())["starts"]]
-    assert [r["cost"] for r in rows] == pytest.approx(kept, rel=1e-12)
+    assert [r["cost"] for r in rows[:6]] == pytest.approx(kept, rel=1e-12)
+    printed = [t["cost_from_30_deg"] for t in json.loads(calibrate.START_ANGLE_REFITS_FILE.read_text())["starts"]]
+    assert [r["cost"] for r in rows[6:]] == pytest.approx(printed, abs=5e-5)
     assert all(r["cost"] <= committed["cost"] + committed["noise"]["std"] for r in rows)  # within the noise
     members = [m["values"] for m in committed["ensemble"]]
-    assert all(r["values"] in members for r in rows)
-    assert committed["version"] == calibrate.FILE_VERSION == 9 and "further starts" in committed["made_by"]
+    assert all(r["values"] in members for r in rows[:6])
+    history = [calibrate.Evaluation(h["values"], h["cost"], h["stage"]) for h in committed["history"]]
+    best = min(history, key=lambda e: e.cost)
+    chosen = calibrate.choose_ensemble(history, best, committed["noise"]["std"])
+    assert [(m["values"], m["cost"], m["stage"]) for m in committed["ensemble"]] == [
+        (e.values, e.cost, e.stage) for e in chosen]
+    assert committed["version"] == calibrate.FILE_VERSION == 10 and "further starts" in committed["made_by"]
+
+
+def test_the_twelfth_refit_is_the_eleventh_with_ten_more_starts():
+    """What the docs say of the twelfth refit against the eleventh's kept file: the same history but for the ten new
+    "previous" rows (value for value, cost for cost, in order), so the same fitted values, cost and noise; two members
+    differ, and they are the 25-deg fit's members 11 and 12."""
+    from twin.plants.as_built import ELEVENTH_REFIT_FILE
+
+    twelfth, eleventh = (json.loads(f.read_text()) for f in (CALIBRATION_FILE, ELEVENTH_REFIT_FILE))
+    angles = [s["values"] for s in json.loads(calibrate.START_ANGLE_REFITS_FILE.read_text())["starts"]]
+    assert [h for h in twelfth["history"] if not (h["stage"] == "previous" and h["values"] in angles)] == eleventh["history"]
+    assert (twelfth["fitted"], twelfth["cost"], twelfth["noise"]) == (eleventh["fitted"], eleventh["cost"], eleventh["noise"])
+    new = [m["values"] for m in twelfth["ensemble"] if m not in eleventh["ensemble"]]
+    assert new == [angles[8], angles[9]] and len(twelfth["ensemble"]) == len(eleventh["ensemble"]) == 13
 
 
 def test_unit_box_maps_onto_the_plausible_bounds():
@@ -332,10 +364,10 @@ def test_same_seeds_same_fit_whatever_the_workers():
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    # the six further starts, evaluated at exactly their values, then two points along each profiled parameter (the
-    # load friction, the breakaway, the observer gain, the CCW scale, the air, the start pressure)
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["previous"] * 6 + ["profile"] * 12
-    assert [e.values for e in one.history[3:9]] == list(calibrate.previous_fits()) and one.evaluations == 21
+    # the sixteen further starts, evaluated at exactly their values, then two points along each profiled parameter
+    # (the load friction, the breakaway, the observer gain, the CCW scale, the air, the start pressure)
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["previous"] * 16 + ["profile"] * 12
+    assert [e.values for e in one.history[3:19]] == list(calibrate.previous_fits()) and one.evaluations == 31
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)

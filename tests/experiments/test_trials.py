@@ -332,7 +332,7 @@ def test_trial_start_refit_on_the_eleventh_code_reports_what_the_docs_quote(caps
     """The trial calibrations fitted on 2026-11-28 (stop 44) with twin calibrate as the eleventh refit made it, T1, T2
     and T4 from 20, 22, 25 and 40 deg, reported again with --from-committed, give what docs/investigations.md,
     docs/prediction.md, docs/as-built.md and the README quote: each file's own table from its start, its T3 cells,
-    its best on the further seed sets, and its members run from the committed start against the committed preset's
+    its best on the further seed sets, and its members run from the committed start against the eleventh refit's
     cut (member 11 of the fit from 25 deg under it, at 4.10 / 3.82 deg on the 13.5 g vertical T3 cells). The trial
     puts the committed start back."""
     from twin.physics import trajectories
@@ -366,20 +366,20 @@ def test_trial_start_refit_on_the_eleventh_code_reports_what_the_docs_quote(caps
             '  smc    13.5 g vertical   3.41  3.40-3.51  3.37-3.95  0',
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSFSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
             'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.703 / 0.735 / 0.623',
-            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            "its members from 30 deg, fit seeds, against the eleventh refit's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
             '  member 0: cost 0.6586',
             '  member 1: cost 0.7159',
             '  member 2: cost 0.6860',
             '  member 3: cost 0.6962',
-            '  member 4: cost 0.5961, under the cut; seeds 10-19 / 20-29 / 30-39 0.813 / 0.765 / 0.850 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.81 / 3.52 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.572, air_fraction 0.04441, ccw_coulomb_scale 1.149, leak_conductance 1.665e-14, load_friction 0.3331, observer_gain 473.4, initial_pressure_fraction 0.5551',
-            '  member 5: cost 0.6297, under the cut; seeds 10-19 / 20-29 / 30-39 0.835 / 0.812 / 0.759 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.61 / 3.45 (FF + PVA / sliding mode), sliding mode ahead in 5 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
-            '  member 6: cost 0.6342, under the cut; seeds 10-19 / 20-29 / 30-39 0.821 / 0.843 / 0.863 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.60 / 3.42 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.269, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
-            '  member 7: cost 0.6136, under the cut; seeds 10-19 / 20-29 / 30-39 0.814 / 0.796 / 0.762 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.67 / 3.46 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.766, air_fraction 0.03764, ccw_coulomb_scale 1.139, leak_conductance 1.591e-14, load_friction 0.3182, observer_gain 497.6, initial_pressure_fraction 0.5304',
-            '  member 8: cost 0.6080, under the cut; seeds 10-19 / 20-29 / 30-39 0.782 / 0.746 / 0.711 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.56 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.25',
+            "  member 4: cost 0.5961, under the cut; seeds 10-19 / 20-29 / 30-39 0.813 / 0.765 / 0.850 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.81 / 3.52 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.572, air_fraction 0.04441, ccw_coulomb_scale 1.149, leak_conductance 1.665e-14, load_friction 0.3331, observer_gain 473.4, initial_pressure_fraction 0.5551",
+            "  member 5: cost 0.6297, under the cut; seeds 10-19 / 20-29 / 30-39 0.835 / 0.812 / 0.759 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.61 / 3.45 (FF + PVA / sliding mode), sliding mode ahead in 5 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5",
+            "  member 6: cost 0.6342, under the cut; seeds 10-19 / 20-29 / 30-39 0.821 / 0.843 / 0.863 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.60 / 3.42 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.269, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5",
+            "  member 7: cost 0.6136, under the cut; seeds 10-19 / 20-29 / 30-39 0.814 / 0.796 / 0.762 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.67 / 3.46 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.766, air_fraction 0.03764, ccw_coulomb_scale 1.139, leak_conductance 1.591e-14, load_friction 0.3182, observer_gain 497.6, initial_pressure_fraction 0.5304",
+            "  member 8: cost 0.6080, under the cut; seeds 10-19 / 20-29 / 30-39 0.782 / 0.746 / 0.711 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.56 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.25",
             '  member 9: cost 0.6609',
-            '  member 10: cost 0.5852, under the cut; seeds 10-19 / 20-29 / 30-39 0.831 / 0.771 / 0.924 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.49 / 3.44 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.75',
-            '  member 11: cost 0.6307, under the cut; seeds 10-19 / 20-29 / 30-39 0.830 / 0.850 / 0.839 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.60 / 3.37 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.202, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
-            '  member 12: cost 0.6212, under the cut; seeds 10-19 / 20-29 / 30-39 0.802 / 0.880 / 0.805 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.66 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.067, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5',
+            "  member 10: cost 0.5852, under the cut; seeds 10-19 / 20-29 / 30-39 0.831 / 0.771 / 0.924 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.49 / 3.44 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.75",
+            "  member 11: cost 0.6307, under the cut; seeds 10-19 / 20-29 / 30-39 0.830 / 0.850 / 0.839 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.60 / 3.37 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.202, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5",
+            "  member 12: cost 0.6212, under the cut; seeds 10-19 / 20-29 / 30-39 0.802 / 0.880 / 0.805 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.66 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.04, ccw_coulomb_scale 1.067, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.5",
         ],
         "22": [
             'T1, T2 and T4 from 22 deg (committed: 30)',
@@ -402,7 +402,7 @@ def test_trial_start_refit_on_the_eleventh_code_reports_what_the_docs_quote(caps
             '  smc    13.5 g vertical   3.82  3.71-3.82  3.70-3.82  0',
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
             'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.805 / 0.794 / 0.838',
-            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            "its members from 30 deg, fit seeds, against the eleventh refit's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
             '  member 0: cost 0.8592',
             '  member 1: cost 0.8883',
             '  member 2: cost 0.9107',
@@ -433,7 +433,7 @@ def test_trial_start_refit_on_the_eleventh_code_reports_what_the_docs_quote(caps
             '  smc    13.5 g vertical   3.81  3.76-3.98  3.70-4.24  0',
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SFSSSS SSSSSS SSSSSS SSSSSS SFFFFS SSSSSS SSSSFS SFSSSS SSSSSS SSSSSS SSSSSS SSSSSS SSSSSS',
             'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.754 / 0.575 / 0.771',
-            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            "its members from 30 deg, fit seeds, against the eleventh refit's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
             '  member 0: cost 0.6919',
             '  member 1: cost 0.8883',
             '  member 2: cost 0.6665',
@@ -445,8 +445,8 @@ def test_trial_start_refit_on_the_eleventh_code_reports_what_the_docs_quote(caps
             '  member 8: cost 0.6903',
             '  member 9: cost 0.6556',
             '  member 10: cost 0.6506',
-            '  member 11: cost 0.5638, under the cut; seeds 10-19 / 20-29 / 30-39 0.744 / 0.666 / 0.673 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 4.10 / 3.82 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.789, air_fraction 0.03428, ccw_coulomb_scale 1.114, leak_conductance 2.832e-14, load_friction 0.3648, observer_gain 559.6, initial_pressure_fraction 0.7421',
-            '  member 12: cost 0.6420, under the cut; seeds 10-19 / 20-29 / 30-39 0.796 / 0.645 / 0.766 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.95 / 3.76 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.877, air_fraction 0.03375, ccw_coulomb_scale 1.127, leak_conductance 2.786e-14, load_friction 0.3449, observer_gain 581.2, initial_pressure_fraction 0.7899',
+            "  member 11: cost 0.5638, under the cut; seeds 10-19 / 20-29 / 30-39 0.744 / 0.666 / 0.673 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 4.10 / 3.82 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.789, air_fraction 0.03428, ccw_coulomb_scale 1.114, leak_conductance 2.832e-14, load_friction 0.3648, observer_gain 559.6, initial_pressure_fraction 0.7421",
+            "  member 12: cost 0.6420, under the cut; seeds 10-19 / 20-29 / 30-39 0.796 / 0.645 / 0.766 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.95 / 3.76 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.877, air_fraction 0.03375, ccw_coulomb_scale 1.127, leak_conductance 2.786e-14, load_friction 0.3449, observer_gain 581.2, initial_pressure_fraction 0.7899",
         ],
         "40": [
             'T1, T2 and T4 from 40 deg (committed: 30)',
@@ -469,9 +469,9 @@ def test_trial_start_refit_on_the_eleventh_code_reports_what_the_docs_quote(caps
             '  smc    13.5 g vertical   3.12  3.11-3.42  3.11-3.43  0',
             'which law leads, per member (H 0 / 6.5 / 13.5 g, V 0 / 6.5 / 13.5 g; S sliding mode, F FF + PVA): SSSSSS SSSSSS SFFFFF FFFFFS FFFFFS SSSSSS SSSSSS FFFFFF',
             'its best on seeds 10-19 / 20-29 / 30-39, from this start: 0.804 / 0.751 / 0.923',
-            "its members from 30 deg, fit seeds, against the committed preset's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
+            "its members from 30 deg, fit seeds, against the eleventh refit's cut 0.6469 (cost 0.5239 + noise 0.1229; preset 78c00bbdf7e4):",
             '  member 0: cost 0.8203',
-            '  member 1: cost 0.5843, under the cut; seeds 10-19 / 20-29 / 30-39 0.795 / 0.789 / 0.873 (the committed preset 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.74 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.052, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.25',
+            "  member 1: cost 0.5843, under the cut; seeds 10-19 / 20-29 / 30-39 0.795 / 0.789 / 0.873 (the eleventh refit's best 0.768 / 0.738 / 0.800); T3 13.5 g vertical 3.74 / 3.41 (FF + PVA / sliding mode), sliding mode ahead in 6 of 6 cells; stiction 1.395, air_fraction 0.052, ccw_coulomb_scale 1.134, leak_conductance 1.5e-14, load_friction 0.3, observer_gain 515, initial_pressure_fraction 0.25",
             '  member 2: cost 0.6977',
             '  member 3: cost 0.8667',
             '  member 4: cost 0.8807',
@@ -643,8 +643,9 @@ def test_the_start_refit_trial_fits_with_out_or_reports_a_kept_file(capsys, monk
 def test_the_start_refit_trials_fit_runs_calibrate_from_its_start_and_writes_a_file_it_reads_back(capsys, tmp_path,
                                                                                                   monkeypatch):
     """--out fits with twin calibrate's code as it is (cut down here to its centre point on two seeds) with T1, T2
-    and T4 from the given start, writes a version-9 file whose code version holds that start (so --calibration
-    reads it back from 20 deg and refuses it from 30) and puts the committed start back."""
+    and T4 from the given start, writes a file of twin calibrate's version whose code version holds that start (so
+    --calibration reads it back from 20 deg and refuses it from 30), puts the committed start back, and refuses to
+    fit over a file already there."""
     import functools
     import json
     import math
@@ -663,16 +664,24 @@ def test_the_start_refit_trials_fit_runs_calibrate_from_its_start_and_writes_a_f
     monkeypatch.setattr(trial.calibrate, "calibrate", fit)
     trial.main(["--start", "20", "--out", str(tmp_path / "fits"), "--workers", "2"])
     out = capsys.readouterr().out
-    path = tmp_path / "fits" / "eleventh_start_20.json"
-    assert f"wrote {path} (file version 9," in out and "members" in out and "T3 (mean RMSE deg" in out
+    path = tmp_path / "fits" / "version10_start_20.json"
+    assert f"wrote {path} (file version 10," in out and "members" in out and "T3 (mean RMSE deg" in out
     assert seen == [pytest.approx(math.radians(20.0))] and trajectories.START == committed
     monkeypatch.undo()
-    assert json.loads(path.read_text())["version"] == calibrate.FILE_VERSION == 9
+    assert json.loads(path.read_text())["version"] == calibrate.FILE_VERSION == 10
     trial.main(["--start", "20", "--calibration", str(path), "--workers", "2"])  # read back from its own start
     assert "each mean as the file's: True" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         trial.main(["--start", "30", "--calibration", str(path)])
     assert "was not fitted from 30 deg with these presets" in capsys.readouterr().err
+
+    def no_fit(**kwargs):
+        raise AssertionError("a fit over a file already there")  # fails at once, where a real fit would run minutes
+
+    monkeypatch.setattr(trial.calibrate, "calibrate", no_fit)
+    with pytest.raises(SystemExit):
+        trial.main(["--start", "20", "--out", str(tmp_path / "fits")])
+    assert f"{path} is there already" in capsys.readouterr().err
 
 
 def test_trial_air_box_refuses_a_box_that_would_misplace_calibrates_parameters(monkeypatch):
@@ -1094,10 +1103,19 @@ def test_the_tenth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
     assert as_built.preset_digest(as_built.TENTH_REFIT_FILE) == "1c2dcd8c9f7f"
 
 
+def test_the_eleventh_refit_kept_for_the_trials_is_the_preset_they_printed_on():
+    from twin.plants import as_built
+
+    # 78c00bbdf7e4: the committed preset of 2026-11-28 until the twelfth refit (the same fitted values, noise and
+    # profiles; another ensemble), that trial_start_refit's --from-committed ran against; it reads this copy.
+    assert as_built.preset_digest(as_built.ELEVENTH_REFIT_FILE) == "78c00bbdf7e4"
+
+
 @pytest.mark.parametrize(("heading", "folder", "member_count"), [
     ("## Beside the fifth: T3 on a trial refit", "trial_air_box", 11),
     ("## Fifth blind prediction: T3 on the ninth refit", "ninth_refit_prediction", 9),  # superseded, kept as packaged
     ("## Sixth blind prediction: T3 on the tenth refit", "tenth_refit_prediction", 11),  # superseded 2026-11-28
+    ("## Seventh blind prediction: T3 on the eleventh refit", "eleventh_refit_prediction", 13),  # superseded 2026-11-28
 ])
 def test_prediction_md_quotes_the_registered_predictions_kept_in_examples(heading, folder, member_count):
     import csv

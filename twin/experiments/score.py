@@ -110,6 +110,10 @@ REGISTERED = (
                  "examples/tenth_refit_prediction)", "2026-11-28", "78c00bbdf7e4",
                  "45b22c579d3cffb7071c12532cd5728eda7af9905332ad1178ccf62049d9abb7",
                  "5af4f15319e6598089c10508607f6f0735b0a48ef078195803026f2eae1b2194"),
+    Registration("the eighth blind prediction (the twelfth refit's; the seventh's files now in "
+                 "examples/eleventh_refit_prediction)", "2026-11-28", "6bb9e9258023",
+                 "c8422e3c611597f727a40d1e98002c5df2676fc132d40a3a4bc6f5c1fca0d99a",
+                 "a7d63a492a6704b2573d16fe13982f682fcf319ff8a6c933d0d447dbabcd6bb1"),
 )
 TIE = "tie"  # the two means equal: neither tracked better (and the order is a toss)
 ORDER_LABELS = {**CONTROLLER_LABELS, TIE: "neither (equal means)"}

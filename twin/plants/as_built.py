@@ -62,6 +62,9 @@ NINTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "ninth_re
 # The tenth refit's calibration file (committed 2026-11-27 to 2026-11-28, digest 1c2dcd8c9f7f), kept as it was: the
 # trials that ran on it read it, and `twin calibrate` starts from its fitted values too.
 TENTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "tenth_refit.json"
+# The eleventh refit's calibration file (committed 2026-11-28, digest 78c00bbdf7e4), kept as it was: the twelfth
+# refit has the same fitted values, noise and profiles, and another ensemble; the trials that ran on it read it.
+ELEVENTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "eleventh_refit.json"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -309,7 +312,7 @@ def preset_digest(path: pathlib.Path | None = None) -> str:
     return hashlib.sha256(repr(plants).encode()).hexdigest()[:12]
 
 
-__all__ = ["ASSUMED", "BEFORE_FITTED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "FITTED",
+__all__ = ["ASSUMED", "BEFORE_FITTED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "ELEVENTH_REFIT_FILE", "FITTED",
            "FULL_DUTY_SPEED_DIGIT", "FULL_DUTY_WINDOW", "SLOWEST_FULL_DUTY_SPEED", "STICTION_SCATTER",
            "as_built_params", "as_built_plant", "calibrated_values", "calibration_cost_line", "ensemble_costs", "ensemble_plants", "ensemble_values", "fits_start_pressure",
            "preset_digest"]
