@@ -997,7 +997,8 @@ def test_a_plotting_librarys_own_oserror_costs_only_the_figure_and_a_full_disk_s
     assert drawn(lambda path: path.write_bytes(b"png"), tmp_path / "c.png", undrawn) == [tmp_path / "c.png"]
 
 
-def test_a_stop_while_a_set_is_renamed_in_waits_until_the_whole_set_is_in(tmp_path, monkeypatch):
+def test_a_stop_while_a_set_is_renamed_in_waits_until_the_whole_set_is_in(tmp_path, monkeypatch,
+                                                                          ctrl_c_as_in_a_terminal):
     """Ctrl-C and SIGTERM that come between two of staged()'s renames are held until the last one: the
     folder gets the whole new set and loses the staging folder, then the stops are delivered in order to
     the handlers they had, each even when an earlier one raised."""
@@ -1007,9 +1008,7 @@ def test_a_stop_while_a_set_is_renamed_in_waits_until_the_whole_set_is_in(tmp_pa
     out.mkdir()
     rename = os.replace
     terms = []
-    before = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
-    signal.signal(signal.SIGINT, signal.default_int_handler)  # as in an interactive run, whatever started pytest
-    signal.signal(signal.SIGTERM, lambda number, frame: terms.append(number))
+    before = signal.signal(signal.SIGTERM, lambda number, frame: terms.append(number))
     try:
         for order in ([signal.SIGTERM, signal.SIGINT], [signal.SIGINT, signal.SIGTERM]):
             for name in ("a.csv", "b.csv", "c.png"):
@@ -1035,8 +1034,7 @@ def test_a_stop_while_a_set_is_renamed_in_waits_until_the_whole_set_is_in(tmp_pa
             assert terms == [signal.SIGTERM]  # delivered after the set was in, whichever came first
             assert signal.getsignal(signal.SIGINT) is signal.default_int_handler
     finally:
-        for signum, handler in before.items():
-            signal.signal(signum, handler)
+        signal.signal(signal.SIGTERM, before)
 
 
 def test_a_folder_in_the_way_of_an_output_file_is_refused_and_no_file_of_the_set_moves(tmp_path, capsys):
