@@ -171,8 +171,13 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
 
 
 def _start_angle_refits() -> list[dict]:
-    """The package's copy of the start-angle trial sets (twin calibrate's last ten further starts)."""
+    """The package's copy of the start-angle trial sets (twin calibrate's further starts 7-16)."""
     return json.loads(calibrate.START_ANGLE_REFITS_FILE.read_text())["starts"]
+
+
+def _profile_refits() -> list[dict]:
+    """The package's copy of the load-friction profile trial's sets (twin calibrate's last three further starts)."""
+    return json.loads(calibrate.PROFILE_REFITS_FILE.read_text())["starts"]
 
 
 def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_one_outside_is_refused():
@@ -183,6 +188,7 @@ def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_on
         ELEVENTH_REFIT_FILE,
         NINTH_REFIT_FILE,
         TENTH_REFIT_FILE,
+        TWELFTH_REFIT_FILE,
         calibration_cost_line,
         preset_digest,
     )
@@ -208,8 +214,18 @@ def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_on
         angles.append(member["values"])
     assert [(s["source"][-7:-5], s["member"]) for s in _start_angle_refits()] == [
         *(("20", m) for m in (4, 5, 6, 7, 8, 10, 11, 12)), ("25", 11), ("25", 12)]
+    profiles, cut = [], sum(calibration_cost_line(TWELFTH_REFIT_FILE))  # the twelfth refit's best + noise
+    for start in _profile_refits():  # the profile trial's refits under that cut, at their exact values
+        source = ROOT / start["source"]
+        assert hashlib.sha256(source.read_bytes()).hexdigest() == start["source_sha256"]
+        (result,) = [r for r in json.loads(source.read_text())["results"] if r["at"] == start["load_friction"]]
+        assert start["values"] == result["values"] and start["cost"] == result["cost"] <= cut
+        assert start["values"]["load_friction"] == start["load_friction"]
+        profiles.append(result["values"])
+    assert [s["load_friction"] for s in _profile_refits()] == [0.40, 0.45, 0.05]
     half = {"initial_pressure_fraction": 0.5}
-    assert calibrate.previous_fits() == ({**ninth["fitted"], **half}, {**tenth["fitted"], **half}, *trials, *angles)
+    assert calibrate.previous_fits() == ({**ninth["fitted"], **half}, {**tenth["fitted"], **half}, *trials, *angles,
+                                         *profiles)
     box = {f.name: f for f in FITTED}
     assert all(box[n].low <= v <= box[n].high for start in calibrate.previous_fits() for n, v in start.items())
     assert box["air_fraction"].high == 0.08 and ninth["bounds"]["air_fraction"]["high"] == 0.03
@@ -225,10 +241,10 @@ def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_on
 
 
 def test_the_committed_file_holds_the_further_starts_as_evaluated_and_its_ensemble_by_the_rule():
-    """The twelfth refit's file: its sixteen "previous" rows, after the simplex and before the profiles, are the
+    """The thirteenth refit's file: its nineteen "previous" rows, after the simplex and before the profiles, are the
     further starts at exactly their values. The six earlier fits each cost what its own file says (to 1e-12: machines
-    differ in the last bits) and are members; the ten start-angle sets cost what the trial printed (4 digits), all
-    within the noise. The ensemble is the rule's choice from the whole history (so which of the ten are members is the
+    differ in the last bits) and are members; the ten start-angle sets cost what the trial printed (4 digits), the
+    three profile refits what the trial's file keeps (to 1e-12), all within the noise. The ensemble is the rule's choice from the whole history (so which of the ten are members is the
     rule's, not picked by hand); made_by says so, and the file is of this version."""
     committed = json.loads(CALIBRATION_FILE.read_text())
     from twin.plants.as_built import NINTH_REFIT_FILE, TENTH_REFIT_FILE
@@ -236,13 +252,14 @@ def test_the_committed_file_holds_the_further_starts_as_evaluated_and_its_ensemb
     stages = [h["stage"] for h in committed["history"]]
     rows = [h for h in committed["history"] if h["stage"] == "previous"]
     first = stages.index("previous")
-    assert stages[first:first + 16] == ["previous"] * 16 and "simplex" not in stages[first:] and "profile" not in stages[:first]
+    assert stages[first:first + 19] == ["previous"] * 19 and "simplex" not in stages[first:] and "profile" not in stages[:first]
     assert [r["values"] for r in rows] == list(calibrate.previous_fits())
     kept = [json.loads(f.read_text())["cost"] for f in (NINTH_REFIT_FILE, TENTH_REFIT_FILE)] + [
         t["cost"] for t in json.loads(calibrate.START_PRESSURE_REFITS_FILE.read_text())["starts"]]
     assert [r["cost"] for r in rows[:6]] == pytest.approx(kept, rel=1e-12)
     printed = [t["cost_from_30_deg"] for t in _start_angle_refits()]
-    assert [r["cost"] for r in rows[6:]] == pytest.approx(printed, abs=5e-5)
+    assert [r["cost"] for r in rows[6:16]] == pytest.approx(printed, abs=5e-5)
+    assert [r["cost"] for r in rows[16:]] == pytest.approx([t["cost"] for t in _profile_refits()], rel=1e-12)
     assert all(r["cost"] <= committed["cost"] + committed["noise"]["std"] for r in rows)  # within the noise
     members = [m["values"] for m in committed["ensemble"]]
     assert all(r["values"] in members for r in rows[:6])
@@ -251,21 +268,42 @@ def test_the_committed_file_holds_the_further_starts_as_evaluated_and_its_ensemb
     chosen = calibrate.choose_ensemble(history, best, committed["noise"]["std"])
     assert [(m["values"], m["cost"], m["stage"]) for m in committed["ensemble"]] == [
         (e.values, e.cost, e.stage) for e in chosen]
-    assert committed["version"] == calibrate.FILE_VERSION == 10 and "further starts" in committed["made_by"]
+    assert committed["version"] == calibrate.FILE_VERSION == 11 and "further starts" in committed["made_by"]
 
 
 def test_the_twelfth_refit_is_the_eleventh_with_ten_more_starts():
     """What the docs say of the twelfth refit against the eleventh's kept file: the same history but for the ten new
     "previous" rows (value for value, cost for cost, in order), so the same fitted values, cost and noise; two members
     differ, and they are the 25-deg fit's members 11 and 12."""
-    from twin.plants.as_built import ELEVENTH_REFIT_FILE
+    from twin.plants.as_built import ELEVENTH_REFIT_FILE, TWELFTH_REFIT_FILE
 
-    twelfth, eleventh = (json.loads(f.read_text()) for f in (CALIBRATION_FILE, ELEVENTH_REFIT_FILE))
+    twelfth, eleventh = (json.loads(f.read_text()) for f in (TWELFTH_REFIT_FILE, ELEVENTH_REFIT_FILE))
     angles = [s["values"] for s in _start_angle_refits()]
     assert [h for h in twelfth["history"] if not (h["stage"] == "previous" and h["values"] in angles)] == eleventh["history"]
     assert (twelfth["fitted"], twelfth["cost"], twelfth["noise"]) == (eleventh["fitted"], eleventh["cost"], eleventh["noise"])
     new = [m["values"] for m in twelfth["ensemble"] if m not in eleventh["ensemble"]]
     assert new == [angles[8], angles[9]] and len(twelfth["ensemble"]) == len(eleventh["ensemble"]) == 13
+
+
+def test_the_thirteenth_refit_is_the_twelfth_with_three_more_starts():
+    """What the docs say of the thirteenth refit against the twelfth's kept file: the same history but for the three
+    new "previous" rows, which come right after the twelfth's sixteen (value for value, cost for cost, in order), so
+    the same fitted values, cost and noise; the members that differ are the rule's choice, among them the profile
+    trial's sets at both ends of the load friction."""
+    from twin.plants.as_built import TWELFTH_REFIT_FILE
+
+    thirteenth, twelfth = (json.loads(f.read_text()) for f in (CALIBRATION_FILE, TWELFTH_REFIT_FILE))
+    profiles = [s["values"] for s in _profile_refits()]
+    history = thirteenth["history"]
+    assert [h for h in history if not (h["stage"] == "previous" and h["values"] in profiles)] == twelfth["history"]
+    first = [h["stage"] for h in history].index("previous")
+    assert [h["values"] for h in history[first + 16:first + 19]] == profiles
+    assert (thirteenth["fitted"], thirteenth["cost"], thirteenth["noise"]) == (
+        twelfth["fitted"], twelfth["cost"], twelfth["noise"])
+    members = [m["values"] for m in thirteenth["ensemble"]]
+    assert profiles[1] in members and profiles[2] in members  # the highest load friction under the cut, the lowest
+    lows = [m["load_friction"] for m in members]
+    assert (min(lows), max(lows)) == (0.05, 0.45) and len(members) == 13
 
 
 def test_unit_box_maps_onto_the_plausible_bounds():

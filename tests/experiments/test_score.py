@@ -117,8 +117,8 @@ def test_score_writes_its_tables_report_and_figure_against_the_committed_predict
     assert "6 of 12 T3 cells within 20 %" in text and "before any T3 measurement was seen" in text
     from twin.plants.as_built import preset_digest
 
-    assert (f"Prediction: the eighth blind prediction (the twelfth refit's; the seventh's files now in "
-            f"examples/eleventh_refit_prediction), registered 2026-11-28 "
+    assert (f"Prediction: the ninth blind prediction (the thirteenth refit's; the eighth's files now in "
+            f"examples/twelfth_refit_prediction), registered 2026-11-28 "
             f"(the package's `twin/experiments/data/`; `twin validate` on as-built preset {preset_digest()})." in text)
     assert sorted(p.name for p in out.iterdir() if not p.name.startswith(".")) == ["orders.csv", "score.csv", "score.md",
                                                                                     "score.png"]
@@ -308,7 +308,13 @@ def test_the_table_prints_what_its_verdicts_read():
 def test_the_registered_predictions_are_append_only_and_each_is_its_files():
     """The predictions on record before any T3 data, pinned: an entry is never changed or removed (a refit's
     prediction is appended); each entry's files and preset are the ones it names."""
-    from twin.plants.as_built import ELEVENTH_REFIT_FILE, NINTH_REFIT_FILE, TENTH_REFIT_FILE, preset_digest
+    from twin.plants.as_built import (
+        ELEVENTH_REFIT_FILE,
+        NINTH_REFIT_FILE,
+        TENTH_REFIT_FILE,
+        TWELFTH_REFIT_FILE,
+        preset_digest,
+    )
 
     assert [(r.name, r.registered, r.preset) for r in score.REGISTERED[:3]] == [
         ("the sixth blind prediction (the tenth refit's)", "2026-11-27", "1c2dcd8c9f7f"),
@@ -316,14 +322,20 @@ def test_the_registered_predictions_are_append_only_and_each_is_its_files():
         ("the air-box trial's prediction (examples/trial_air_box)", "2026-11-27", "3da50147f0ac")]
     assert [(r.cells_sha256[:12], r.members_sha256[:12]) for r in score.REGISTERED[:3]] == [
         ("aa932337bc6b", "32a6f6bce029"), ("4ca2fdca0a47", "28fd859f4e28"), ("9a133fe74794", "37fe7c0cde01")]
-    sixth, fifth, trial, seventh, eighth = score.REGISTERED[:5]
+    sixth, fifth, trial, seventh, eighth, ninth = score.REGISTERED[:6]
     assert (seventh.name, seventh.registered, seventh.preset, seventh.cells_sha256[:12], seventh.members_sha256[:12]) == (
         "the seventh blind prediction (the eleventh refit's; the sixth's files now in examples/tenth_refit_prediction)",
         "2026-11-28", "78c00bbdf7e4", "45b22c579d3c", "5af4f15319e6")
     assert (eighth.name, eighth.registered, eighth.preset, eighth.cells_sha256[:12], eighth.members_sha256[:12]) == (
         "the eighth blind prediction (the twelfth refit's; the seventh's files now in examples/eleventh_refit_prediction)",
         "2026-11-28", "6bb9e9258023", "c8422e3c6115", "a7d63a492a67")
-    assert score.registration() == eighth and eighth.preset == preset_digest()  # the packaged files, the committed
+    assert (ninth.name, ninth.registered, ninth.preset, ninth.cells_sha256[:12], ninth.members_sha256[:12]) == (
+        "the ninth blind prediction (the thirteenth refit's; the eighth's files now in examples/twelfth_refit_prediction)",
+        "2026-11-28", "13aadbb61885", "2d0fb3160c9d", "ec338bcdb86e")
+    assert len(score.REGISTERED) == 6
+    assert score.registration() == ninth and ninth.preset == preset_digest()  # the packaged files, the committed
+    assert score.registration(ROOT / "examples" / "twelfth_refit_prediction") == eighth
+    assert eighth.preset == preset_digest(TWELFTH_REFIT_FILE)
     assert score.registration(ROOT / "examples" / "eleventh_refit_prediction") == seventh
     assert seventh.preset == preset_digest(ELEVENTH_REFIT_FILE)
     assert score.registration(ROOT / "examples" / "tenth_refit_prediction") == sixth

@@ -1111,11 +1111,80 @@ def test_the_eleventh_refit_kept_for_the_trials_is_the_preset_they_printed_on():
     assert as_built.preset_digest(as_built.ELEVENTH_REFIT_FILE) == "78c00bbdf7e4"
 
 
+def test_the_twelfth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
+    from twin.plants import as_built
+
+    # 6bb9e9258023: the committed preset of 2026-11-28 (stop 45) until the thirteenth refit (the same fitted values,
+    # noise and profiles; another ensemble), that trial_profile_likelihood ran on; it reads this copy by default.
+    assert as_built.preset_digest(as_built.TWELFTH_REFIT_FILE) == "6bb9e9258023"
+
+
+@pytest.mark.parametrize(("argv", "said"), [
+    ([], "give --at VALUE ... (a profile now) or --check FILE (a kept one run again), one of them"),
+    (["--at", "0.4", "--check", "x.json"], "one of them"),
+    (["--at", "0.4", "0.61"], "--at 0.61: load_friction must lie in its box, 0-0.6"),
+    (["--parameter", "air_fraction", "--at", "0.09"], "--at 0.09: air_fraction must lie in its box, 0-0.08"),
+    (["--at", "0.4", "--evaluations", "6"], "--evaluations 6: the first simplex alone needs 7"),
+    (["--at", "0.4", "--out", "kept.json"], "kept.json is there already: give another --out"),
+    (["--at", "0.4", "--out", "nowhere/x.json"], "nowhere is not a folder"),
+    (["--parameter", "friction", "--at", "0.4"], "invalid choice: 'friction'"),
+])
+def test_the_profile_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch, tmp_path, argv, said):
+    """A value outside the parameter's box, a budget under the first simplex, an --out that is there already or in no
+    folder, and --at with --check or neither: one-line errors, before any evaluation (a run here fails at once)."""
+    from twin.experiments import calibrate
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the trial started its runs")
+
+    monkeypatch.setattr(calibrate, "Evaluator", no_run)
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "kept.json").write_text("{}")
+    with pytest.raises(SystemExit) as stop:
+        _load("trial_profile_likelihood").main(argv)
+    assert stop.value.code == 2 and said in capsys.readouterr().err
+
+
+def test_the_profile_trials_kept_file_is_what_its_text_and_the_docs_quote():
+    """The kept load-friction profile: run on the twelfth refit's kept file, complete, its five values in the order
+    run, and the printed costs and 13.5 g vertical T3 cells those of its results (docs/investigations.md quotes
+    them)."""
+    import json
+
+    folder = ROOT / "examples" / "trial_profile_likelihood"
+    kept = json.loads((folder / "load_friction.json").read_text())
+    printed = (folder / "load_friction.txt").read_text()
+    assert kept["preset"] == "6bb9e9258023" and kept["complete"] and len(kept["evaluations"]) == 120
+    assert [r["at"] for r in kept["results"]] == [0.40, 0.45, 0.50, 0.10, 0.05]
+    costs = [float(c) for c in re.findall(r"^  cost (\d\.\d+) \(", printed, re.M)]
+    assert costs == [round(r["cost"], 4) for r in kept["results"]]
+    assert [r["under_cut"] for r in kept["results"]] == [True, True, False, False, True]
+    assert all(r["under_cut"] == (r["cost"] <= kept["cut"]) for r in kept["results"])
+    for r in kept["results"]:  # each value's result is the lowest of its own evaluations
+        own = [e["cost"] for e in kept["evaluations"] if e["at"] == r["at"]]
+        assert len(own) == 24 and r["cost"] == min(own)
+    vertical = [[t["twin_mean"] for t in r["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]
+                for r in kept["results"]]
+    assert [f"{a:.2f} / {b:.2f}" for a, b in vertical] == [
+        "4.28 / 4.09", "4.87 / 4.50", "5.51 / 4.90", "3.11 / 2.79", "3.09 / 2.75"]
+
+
+@pytest.mark.slow  # about 1 min on 2 cores: five parameter sets on the fit's 21 cells x 10 seeds and T3's 12 x 5
+def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys):
+    _load("trial_profile_likelihood").main(["--check", str(ROOT / "examples" / "trial_profile_likelihood" /
+                                                              "load_friction.json")])
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0].endswith("preset 6bb9e9258023, 5 values of load_friction")
+    assert [line.split(":")[0].strip() for line in lines[1:]] == ["0.4", "0.45", "0.5", "0.1", "0.05"]
+    assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
+
+
 @pytest.mark.parametrize(("heading", "folder", "member_count"), [
     ("## Beside the fifth: T3 on a trial refit", "trial_air_box", 11),
     ("## Fifth blind prediction: T3 on the ninth refit", "ninth_refit_prediction", 9),  # superseded, kept as packaged
     ("## Sixth blind prediction: T3 on the tenth refit", "tenth_refit_prediction", 11),  # superseded 2026-11-28
     ("## Seventh blind prediction: T3 on the eleventh refit", "eleventh_refit_prediction", 13),  # superseded 2026-11-28
+    ("## Eighth blind prediction: T3 on the twelfth refit", "twelfth_refit_prediction", 13),  # superseded 2026-11-28
 ])
 def test_prediction_md_quotes_the_registered_predictions_kept_in_examples(heading, folder, member_count):
     import csv

@@ -114,6 +114,10 @@ REGISTERED = (
                  "examples/eleventh_refit_prediction)", "2026-11-28", "6bb9e9258023",
                  "c8422e3c611597f727a40d1e98002c5df2676fc132d40a3a4bc6f5c1fca0d99a",
                  "a7d63a492a6704b2573d16fe13982f682fcf319ff8a6c933d0d447dbabcd6bb1"),
+    Registration("the ninth blind prediction (the thirteenth refit's; the eighth's files now in "
+                 "examples/twelfth_refit_prediction)", "2026-11-28", "13aadbb61885",
+                 "2d0fb3160c9d6f7b13547b5b7be4415490d953b64caa14de745542a70c7d9a6a",
+                 "ec338bcdb86e2d0dc9a8a35bb064c244e089a11d50ecc956580a188aee28e807"),
 )
 TIE = "tie"  # the two means equal: neither tracked better (and the order is a toss)
 ORDER_LABELS = {**CONTROLLER_LABELS, TIE: "neither (equal means)"}

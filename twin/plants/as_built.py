@@ -65,6 +65,10 @@ TENTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "tenth_re
 # The eleventh refit's calibration file (committed 2026-11-28, digest 78c00bbdf7e4), kept as it was: the twelfth
 # refit has the same fitted values, noise and profiles, and another ensemble; the trials that ran on it read it.
 ELEVENTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "eleventh_refit.json"
+# The twelfth refit's calibration file (committed 2026-11-28, stop 45, digest 6bb9e9258023), kept as it was: the
+# thirteenth refit has the same fitted values, noise and profiles, and another ensemble; the load-friction profile
+# trial (examples/trial_profile_likelihood.py) ran on it.
+TWELFTH_REFIT_FILE = importlib.resources.files("twin.plants") / "data" / "twelfth_refit.json"
 
 
 @dataclasses.dataclass(frozen=True)
@@ -313,6 +317,6 @@ def preset_digest(path: pathlib.Path | None = None) -> str:
 
 
 __all__ = ["ASSUMED", "BEFORE_FITTED", "BREAKAWAY_BOUND", "BREAKAWAY_TEST_PRESSURE", "CALIBRATION_FILE", "CCW_SCALE_BOUND", "EFFECTS", "ELEVENTH_REFIT_FILE", "FITTED",
-           "FULL_DUTY_SPEED_DIGIT", "FULL_DUTY_WINDOW", "SLOWEST_FULL_DUTY_SPEED", "STICTION_SCATTER",
+           "FULL_DUTY_SPEED_DIGIT", "FULL_DUTY_WINDOW", "SLOWEST_FULL_DUTY_SPEED", "STICTION_SCATTER", "TWELFTH_REFIT_FILE",
            "as_built_params", "as_built_plant", "calibrated_values", "calibration_cost_line", "ensemble_costs", "ensemble_plants", "ensemble_values", "fits_start_pressure",
            "preset_digest"]

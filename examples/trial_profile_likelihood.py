@@ -1,0 +1,193 @@
+"""Trial (not installed): a profile of the fit's cost in one fitted parameter with the others refitted at each point,
+and the T3 prediction where it stays under the ensemble's cut.
+
+``twin calibrate``'s profiles move one parameter about the best with the other six held at the best's values, and
+the ensemble keeps the evaluated sets whose cost is within the best's seed-to-seed noise (the cut). A set with the
+parameter further out and the others moved to make up for it is in no profile and, unless the search reached it, in
+no ensemble; the stop-44 trial found one such set (docs/prediction.md). This trial asks the question for one
+parameter at values past the ensemble's range: at each value, hold the parameter there and refit the other six by
+Nelder-Mead from the nearest set already known (an ensemble member, or this trial's refit at the value before),
+on the fit's seeds and cost, as ``twin calibrate`` evaluates them. A refit's cost is an upper bound of the true
+profile there (a longer search can only find lower), so a point under the cut shows a set that fits as well, and
+a point over it shows only that this search found none. For each refit it prints the cost against the cut, the
+refitted values, the measured RMSE cells within 20 % on seeds 0-4, and the twelve T3 cells (seeds 0-4, as
+``twin validate`` runs them) beside the ensemble's members' range.
+
+The calibration file is the twelfth refit's, which it first ran on (``twin/plants/data/twelfth_refit.json``, digest
+6bb9e9258023), unless ``--calibration`` names another; its preset digest is printed. Nothing is installed or
+refitted in the package, and no T3 measurement was seen. ``--out FILE`` keeps every evaluation and each point's
+result as JSON (written whole once the trial ends, refused if the file is there; on a stop, what ran is written
+before it stops). ``--check FILE`` runs a kept file's results again (each value's refitted set on the fit seeds, and
+its T3 cells) and prints whether they give the kept costs and cells, in about a minute.
+
+On 2026-11-28 (stop 46) it ran the load friction at 0.40, 0.45, 0.50, 0.10 and 0.05 N/N (120 evaluations, 543 s on
+2 cores): ``examples/trial_profile_likelihood/load_friction.json`` and ``.txt`` (what it printed). The results are
+recorded in docs/investigations.md; the sets under the cut are further starts of ``twin calibrate`` since file
+version 11 (``twin/plants/data/profile_refits.json``).
+
+    python examples/trial_profile_likelihood.py --parameter load_friction --at 0.40 0.45 0.50 0.10 0.05 --out FILE
+    python examples/trial_profile_likelihood.py --check examples/trial_profile_likelihood/load_friction.json
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import pathlib
+import sys
+import time
+
+import numpy as np
+
+from twin.experiments import calibrate
+from twin.experiments.validate import PREDICTION_CELLS, SEEDS, lead_counts, rmse_within
+from twin.plants.as_built import FITTED, TWELFTH_REFIT_FILE, calibration_cost_line, preset_digest
+
+STEP = 0.10  # the initial simplex's step per refitted parameter, in unit-box coordinates (into the box)
+EVALUATIONS = 24  # per point: twin calibrate's simplex budget
+MEASURED_SEEDS = SEEDS  # the verdict's five runs, cut from the fit's ten
+
+
+class _Spent(Exception):
+    """A point's refit has used its evaluations."""
+
+
+def refit(evaluator: calibrate.Evaluator, name: str, value: float, start: dict[str, float], budget: int,
+          log: list[dict]) -> tuple[dict[str, float], float, list[calibrate.CellResult]]:
+    """The other fitted parameters refitted with ``name`` held at ``value``, by Nelder-Mead from ``start`` (its
+    ``name`` replaced) over at most ``budget`` evaluations; each evaluation appended to ``log``. Returns the lowest
+    cost's values, cost and cells."""
+    free = [i for i, f in enumerate(FITTED) if f.name != name]
+    base = np.array(calibrate.unit_of({**start, name: value}))
+    seen: dict[tuple, tuple[float, dict, list]] = {}
+
+    def objective(x: np.ndarray) -> float:
+        u = base.copy()
+        u[free] = np.clip(x, 0.0, 1.0)
+        key = tuple(round(float(c), calibrate.SAME_VALUE_DIGITS) for c in u[free])
+        if key not in seen:
+            if len(seen) >= budget:
+                raise _Spent
+            values = {**calibrate.values_at(u), name: value}  # held exactly, not through the box's round trip
+            cells = evaluator.cells(values)
+            seen[key] = (calibrate.cost(cells), values, cells)
+            log.append({"parameter": name, "at": value, "cost": seen[key][0], "values": values})
+            print(f"  [{len(seen)}/{budget}] cost {seen[key][0]:.4f}", file=sys.stderr, flush=True)
+        return seen[key][0]
+
+    x0 = base[free]
+    step = np.where(x0 > 0.5, -STEP, STEP)
+    simplex = np.vstack([x0] + [x0 + step[i] * np.eye(len(free))[i] for i in range(len(free))])
+    try:
+        from scipy.optimize import minimize
+        minimize(objective, x0, method="Nelder-Mead", options={"initial_simplex": simplex, "xatol": 0.01,
+                                                                "fatol": 1e-3})
+    except _Spent:
+        pass
+    best_cost, values, cells = min(seen.values(), key=lambda s: s[0])
+    return values, best_cost, cells
+
+
+def nearest(name: str, value: float, known: list[tuple[dict[str, float], float]]) -> tuple[dict[str, float], float]:
+    """Of the ``known`` (values, cost) sets, the one whose ``name`` is nearest ``value``, the cheapest of a tie."""
+    return min(known, key=lambda k: (abs(k[0][name] - value), k[1]))
+
+
+def t3_cells(evaluator: calibrate.Evaluator, values: dict[str, float]) -> list[float]:
+    """The twelve T3 cells' mean RMSE (deg) on seeds 0-4, in PREDICTION_CELLS' order."""
+    return [c.mean_rmse for c in evaluator.cells(values, keys=PREDICTION_CELLS, seeds=SEEDS)]
+
+
+def check(path: pathlib.Path, workers: int) -> None:
+    """Run each result of the kept trial file ``path`` again (its refitted values on the fit seeds, then its T3
+    cells) and print whether the cost and the twelve cells are the kept ones, to the last bit."""
+    kept = json.loads(path.read_text())
+    print(f"{path}: preset {kept['preset']}, {len(kept['results'])} values of {kept['results'][0]['parameter']}")
+    with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
+        for result in kept["results"]:
+            cost = calibrate.cost(evaluator.cells(result["values"]))
+            t3 = t3_cells(evaluator, result["values"])
+            print(f"  {result['at']:g}: cost {cost:.4f}, as kept: {cost == result['cost']}; T3 cells as kept: "
+                  f"{t3 == [c['twin_mean'] for c in result['t3']]}", flush=True)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    names = [f.name for f in FITTED]
+    parser.add_argument("--parameter", default="load_friction", choices=names, help="the profiled parameter")
+    parser.add_argument("--at", type=float, nargs="+", metavar="VALUE",
+                        help="its values (SI, as the calibration file), each inside its box; run in the order given")
+    parser.add_argument("--check", type=pathlib.Path, metavar="FILE", help="run a kept trial file's results again")
+    parser.add_argument("--calibration", type=pathlib.Path, default=None, help="the calibration file (default: the "
+                        "twelfth refit's kept file)")
+    parser.add_argument("--evaluations", type=int, default=EVALUATIONS, help="refit budget per value")
+    parser.add_argument("--out", type=pathlib.Path, metavar="FILE", help="keep the evaluations and results as JSON")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args(argv)
+    if (args.at is None) == (args.check is None):
+        parser.error("give --at VALUE ... (a profile now) or --check FILE (a kept one run again), one of them")
+    if args.check is not None:
+        check(args.check, args.workers)
+        return
+    box = FITTED[calibrate.FITTED_INDEX[args.parameter]]
+    outside = [v for v in args.at if not box.low <= v <= box.high]
+    if outside:
+        parser.error(f"--at {outside[0]:g}: {args.parameter} must lie in its box, {box.low:g}-{box.high:g}")
+    if args.evaluations < len(FITTED):
+        parser.error(f"--evaluations {args.evaluations}: the first simplex alone needs {len(FITTED)}")
+    if args.out is not None and args.out.exists():
+        parser.error(f"{args.out} is there already: give another --out")
+    if args.out is not None and not args.out.parent.is_dir():
+        parser.error(f"{args.out.parent} is not a folder")
+    path = TWELFTH_REFIT_FILE if args.calibration is None else args.calibration
+    data = json.loads(pathlib.Path(path).read_text())
+    best, noise = calibration_cost_line(path)
+    cut = best + noise
+    members = [({**m["values"]}, float(m["cost"])) for m in data["ensemble"]]
+    lows = [m[0][args.parameter] for m in members]
+    print(f"preset {preset_digest(path)}: cut {cut:.4f} (cost {best:.4f} + noise {noise:.4f}); the ensemble's "
+          f"{args.parameter} {min(lows):.4g}-{max(lows):.4g}; each value refitted over {args.evaluations} evaluations "
+          f"of the other {len(FITTED) - 1}, fit seeds {calibrate.FIT_SEEDS[0]}-{calibrate.FIT_SEEDS[-1]}")
+    rows = [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
+    log: list[dict] = []
+    results: list[dict] = []
+    known = list(members)
+    started = time.perf_counter()
+    try:
+        with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=args.workers) as evaluator:
+            ensemble_t3 = np.array([t3_cells(evaluator, m) for m, _ in members])  # (members, cells)
+            for value in args.at:
+                start, start_cost = nearest(args.parameter, value, known)
+                print(f"{args.parameter} {value:g}: from the set at {start[args.parameter]:.4g} (cost "
+                      f"{start_cost:.4f})", flush=True)
+                values, cost, cells = refit(evaluator, args.parameter, value, start, args.evaluations, log)
+                known.append((values, cost))
+                measured = calibrate._cells_of(cells, MEASURED_SEEDS)
+                within = sum(bool(rmse_within(c.mean_rmse, calibrate.TARGET_OF[c.key].rmse_deg)) for c in measured)
+                t3 = t3_cells(evaluator, values)
+                ahead = lead_counts(rows, t3)[0].get("smc", 0)
+                results.append({"parameter": args.parameter, "at": value, "cost": cost, "under_cut": cost <= cut,
+                                "values": values, "measured_rmse_cells_within": within,
+                                "t3": [{**r, "twin_mean": m} for r, m in zip(rows, t3, strict=True)]})
+                print(f"  cost {cost:.4f} ({'under' if cost <= cut else 'over'} the cut by {abs(cost - cut):.4f}); "
+                      f"{within} of {len(measured)} measured RMSE cells within 20 % (seeds 0-4); "
+                      + ", ".join(f"{k} {v:.4g}" for k, v in values.items()), flush=True)
+                for r, m, span in zip(rows, t3, ensemble_t3.T, strict=True):
+                    outside_span = "" if span.min() <= m <= span.max() else " (outside the members' range)"
+                    print(f"    T3 {r['controller']:6} {r['payload_g']:4g} g {r['orientation']:10} {m:.2f}  members "
+                          f"{span.min():.2f}-{span.max():.2f}{outside_span}", flush=True)
+                print(f"    sliding mode ahead in {ahead} of 6 T3 cells", flush=True)
+    finally:
+        if args.out is not None and log:
+            part = args.out.with_name(args.out.name + ".part")
+            part.write_text(json.dumps({"calibration": str(path), "preset": preset_digest(path), "cut": cut,
+                                        "evaluations_per_value": args.evaluations, "results": results,
+                                        "evaluations": log, "wall_time_s": time.perf_counter() - started,
+                                        "complete": len(results) == len(args.at)}, indent=1) + "\n")
+            part.replace(args.out)
+            print(f"wrote {args.out}", file=sys.stderr)
+    print(f"{len(log)} evaluations in {time.perf_counter() - started:.0f} s")
+
+
+if __name__ == "__main__":
+    main()
