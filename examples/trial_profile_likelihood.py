@@ -18,10 +18,11 @@ The calibration file is the twelfth refit's, which it first ran on (``twin/plant
 refitted in the package, and no T3 measurement was seen. ``--out FILE`` keeps every evaluation and each point's
 result as JSON (written whole once the trial ends, refused if the file is there; on a stop, what ran is written
 before it stops). ``--check FILE`` runs a kept file's results again (each value's refitted set on the fit seeds, and
-its T3 cells) and prints whether they give the kept costs and cells, in about a minute.
+its T3 cells) and prints whether they give the kept costs and cells, in about a minute; it exits 1 if any does not.
 
 On 2026-11-28 (stop 46) it ran the load friction at 0.40, 0.45, 0.50, 0.10 and 0.05 N/N (120 evaluations, 543 s on
-2 cores): ``examples/trial_profile_likelihood/load_friction.json`` and ``.txt`` (what it printed). The results are
+2 cores): ``examples/trial_profile_likelihood/load_friction.json`` and ``.txt`` (what it printed; the file's
+``calibration`` names the committed file as it then was, the twelfth refit, whose digest it keeps). The results are
 recorded in docs/investigations.md; the sets under the cut are further starts of ``twin calibrate`` since file
 version 11 (``twin/plants/data/profile_refits.json``).
 
@@ -39,6 +40,7 @@ import time
 
 import numpy as np
 
+from twin.exceptions import TwinError
 from twin.experiments import calibrate
 from twin.experiments.validate import PREDICTION_CELLS, SEEDS, lead_counts, rmse_within
 from twin.plants.as_built import FITTED, TWELFTH_REFIT_FILE, calibration_cost_line, preset_digest
@@ -98,17 +100,31 @@ def t3_cells(evaluator: calibrate.Evaluator, values: dict[str, float]) -> list[f
     return [c.mean_rmse for c in evaluator.cells(values, keys=PREDICTION_CELLS, seeds=SEEDS)]
 
 
-def check(path: pathlib.Path, workers: int) -> None:
-    """Run each result of the kept trial file ``path`` again (its refitted values on the fit seeds, then its T3
-    cells) and print whether the cost and the twelve cells are the kept ones, to the last bit."""
-    kept = json.loads(path.read_text())
+def read_json(parser: argparse.ArgumentParser, path: pathlib.Path, flag: str) -> dict:
+    """The JSON object in ``path``, or a one-line parser error naming ``flag``."""
+    try:
+        data = json.loads(pathlib.Path(path).read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        parser.error(f"{flag} {path}: cannot read it as JSON ({error.__class__.__name__})")
+    if not isinstance(data, dict):
+        parser.error(f"{flag} {path}: not a JSON object")
+    return data
+
+
+def check(kept: dict, path: pathlib.Path, workers: int) -> bool:
+    """Run each result of the kept trial file ``kept`` (read from ``path``) again (its refitted values on the fit
+    seeds, then its T3 cells) and print whether the cost and the twelve cells are the kept ones, to the last bit;
+    True when every one is."""
     print(f"{path}: preset {kept['preset']}, {len(kept['results'])} values of {kept['results'][0]['parameter']}")
+    same = True
     with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
         for result in kept["results"]:
             cost = calibrate.cost(evaluator.cells(result["values"]))
             t3 = t3_cells(evaluator, result["values"])
-            print(f"  {result['at']:g}: cost {cost:.4f}, as kept: {cost == result['cost']}; T3 cells as kept: "
-                  f"{t3 == [c['twin_mean'] for c in result['t3']]}", flush=True)
+            both = (cost == result["cost"], t3 == [c["twin_mean"] for c in result["t3"]])
+            same = same and all(both)
+            print(f"  {result['at']:g}: cost {cost:.4f}, as kept: {both[0]}; T3 cells as kept: {both[1]}", flush=True)
+    return same
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -127,7 +143,13 @@ def main(argv: list[str] | None = None) -> None:
     if (args.at is None) == (args.check is None):
         parser.error("give --at VALUE ... (a profile now) or --check FILE (a kept one run again), one of them")
     if args.check is not None:
-        check(args.check, args.workers)
+        if args.out is not None:
+            parser.error("--out keeps a profile run now (--at); --check writes nothing")
+        kept = read_json(parser, args.check, "--check")
+        if not isinstance(kept.get("results"), list) or not kept["results"] or "preset" not in kept:
+            parser.error(f"--check {args.check}: not a kept profile trial file (no results)")
+        if not check(kept, args.check, args.workers):
+            sys.exit(1)
         return
     box = FITTED[calibrate.FITTED_INDEX[args.parameter]]
     outside = [v for v in args.at if not box.low <= v <= box.high]
@@ -140,8 +162,15 @@ def main(argv: list[str] | None = None) -> None:
     if args.out is not None and not args.out.parent.is_dir():
         parser.error(f"{args.out.parent} is not a folder")
     path = TWELFTH_REFIT_FILE if args.calibration is None else args.calibration
-    data = json.loads(pathlib.Path(path).read_text())
-    best, noise = calibration_cost_line(path)
+    data = read_json(parser, path, "--calibration")
+    ensemble = data.get("ensemble")
+    if not isinstance(ensemble, list) or not ensemble or not all(
+            isinstance(m, dict) and set(names) <= set(m.get("values", {})) for m in ensemble):
+        parser.error(f"--calibration {path}: not a calibration file with an ensemble of the fitted parameters")
+    try:
+        best, noise = calibration_cost_line(path)
+    except TwinError as error:
+        parser.error(f"--calibration {path}: {error}")
     cut = best + noise
     members = [({**m["values"]}, float(m["cost"])) for m in data["ensemble"]]
     lows = [m[0][args.parameter] for m in members]
@@ -184,8 +213,11 @@ def main(argv: list[str] | None = None) -> None:
                                         "evaluations_per_value": args.evaluations, "results": results,
                                         "evaluations": log, "wall_time_s": time.perf_counter() - started,
                                         "complete": len(results) == len(args.at)}, indent=1) + "\n")
-            part.replace(args.out)
-            print(f"wrote {args.out}", file=sys.stderr)
+            if args.out.exists():  # it appeared while the trial ran: not replaced
+                print(f"{args.out} appeared while the trial ran; kept its results in {part}", file=sys.stderr)
+            else:
+                part.replace(args.out)
+                print(f"wrote {args.out}", file=sys.stderr)
     print(f"{len(log)} evaluations in {time.perf_counter() - started:.0f} s")
 
 

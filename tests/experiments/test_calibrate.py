@@ -182,8 +182,9 @@ def _profile_refits() -> list[dict]:
 
 def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_one_outside_is_refused():
     """The ninth and tenth refits' fitted values, with the chambers at half the supply as then assumed, then the four
-    start-pressure trial refits' at their fractions, each to the last bit of its kept file (the package's copy of the
-    trial fits is held to those files by their SHA-256)."""
+    start-pressure trial refits' at their fractions, then the ten start-angle trial members under the eleventh refit's
+    cut, then the three load-friction profile refits under the twelfth's, each to the last bit of its kept file (the
+    package's copies of the trial sets are held to those files by their SHA-256)."""
     from twin.plants.as_built import (
         ELEVENTH_REFIT_FILE,
         NINTH_REFIT_FILE,
@@ -413,10 +414,10 @@ def test_same_seeds_same_fit_whatever_the_workers():
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    # the sixteen further starts, evaluated at exactly their values, then two points along each profiled parameter
+    # the nineteen further starts, evaluated at exactly their values, then two points along each profiled parameter
     # (the load friction, the breakaway, the observer gain, the CCW scale, the air, the start pressure)
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["previous"] * 16 + ["profile"] * 12
-    assert [e.values for e in one.history[3:19]] == list(calibrate.previous_fits()) and one.evaluations == 31
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["previous"] * 19 + ["profile"] * 12
+    assert [e.values for e in one.history[3:22]] == list(calibrate.previous_fits()) and one.evaluations == 34
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)

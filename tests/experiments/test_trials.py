@@ -664,11 +664,11 @@ def test_the_start_refit_trials_fit_runs_calibrate_from_its_start_and_writes_a_f
     monkeypatch.setattr(trial.calibrate, "calibrate", fit)
     trial.main(["--start", "20", "--out", str(tmp_path / "fits"), "--workers", "2"])
     out = capsys.readouterr().out
-    path = tmp_path / "fits" / "version10_start_20.json"
-    assert f"wrote {path} (file version 10," in out and "members" in out and "T3 (mean RMSE deg" in out
+    path = tmp_path / "fits" / "version11_start_20.json"
+    assert f"wrote {path} (file version 11," in out and "members" in out and "T3 (mean RMSE deg" in out
     assert seen == [pytest.approx(math.radians(20.0))] and trajectories.START == committed
     monkeypatch.undo()
-    assert json.loads(path.read_text())["version"] == calibrate.FILE_VERSION == 10
+    assert json.loads(path.read_text())["version"] == calibrate.FILE_VERSION == 11
     trial.main(["--start", "20", "--calibration", str(path), "--workers", "2"])  # read back from its own start
     assert "each mean as the file's: True" in capsys.readouterr().out
     with pytest.raises(SystemExit):
@@ -1128,10 +1128,17 @@ def test_the_twelfth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
     (["--at", "0.4", "--out", "kept.json"], "kept.json is there already: give another --out"),
     (["--at", "0.4", "--out", "nowhere/x.json"], "nowhere is not a folder"),
     (["--parameter", "friction", "--at", "0.4"], "invalid choice: 'friction'"),
+    (["--check", "missing.json"], "--check missing.json: cannot read it as JSON (FileNotFoundError)"),
+    (["--check", "broken.json"], "--check broken.json: cannot read it as JSON (JSONDecodeError)"),
+    (["--check", "kept.json"], "--check kept.json: not a kept profile trial file (no results)"),
+    (["--check", "kept.json", "--out", "y.json"], "--out keeps a profile run now (--at); --check writes nothing"),
+    (["--at", "0.4", "--calibration", "missing.json"], "--calibration missing.json: cannot read it as JSON"),
+    (["--at", "0.4", "--calibration", "kept.json"], "--calibration kept.json: not a calibration file with an ensemble"),
 ])
 def test_the_profile_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch, tmp_path, argv, said):
     """A value outside the parameter's box, a budget under the first simplex, an --out that is there already or in no
-    folder, and --at with --check or neither: one-line errors, before any evaluation (a run here fails at once)."""
+    folder or given with --check, --at with --check or neither, and a --check or --calibration file that is missing,
+    not JSON or not of its kind: one-line errors, before any evaluation (a run here fails at once)."""
     from twin.experiments import calibrate
 
     def no_run(*args, **kwargs):
@@ -1140,24 +1147,72 @@ def test_the_profile_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch,
     monkeypatch.setattr(calibrate, "Evaluator", no_run)
     monkeypatch.chdir(tmp_path)
     (tmp_path / "kept.json").write_text("{}")
+    (tmp_path / "broken.json").write_text("{")
     with pytest.raises(SystemExit) as stop:
         _load("trial_profile_likelihood").main(argv)
-    assert stop.value.code == 2 and said in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and said in err and "Traceback" not in err
+
+
+def test_the_profile_trials_check_exits_1_when_a_kept_number_is_not_run_again(capsys, monkeypatch, tmp_path):
+    """--check says which kept results it does not get again, and exits 1 (a kept cost one bit off here; the runs
+    are stubbed: the cells' cost and the T3 cells are what the kept file says but for that)."""
+    import json
+
+    kept = json.loads((ROOT / "examples" / "trial_profile_likelihood" / "load_friction.json").read_text())
+    kept["results"] = kept["results"][:2]
+    kept["results"][1]["cost"] += 1e-15
+    path = tmp_path / "kept.json"
+    path.write_text(json.dumps(kept))
+    trial = _load("trial_profile_likelihood")
+    original = {r["at"]: r for r in json.loads(
+        (ROOT / "examples" / "trial_profile_likelihood" / "load_friction.json").read_text())["results"]}
+
+    class Stub:
+        def __init__(self, **kwargs):
+            pass
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return False
+
+        def cells(self, values, **kwargs):
+            return values
+
+    monkeypatch.setattr(trial.calibrate, "Evaluator", Stub)
+    monkeypatch.setattr(trial.calibrate, "cost", lambda values: original[values["load_friction"]]["cost"])
+    monkeypatch.setattr(trial, "t3_cells", lambda evaluator, values: [
+        c["twin_mean"] for c in original[values["load_friction"]]["t3"]])
+    with pytest.raises(SystemExit) as stop:
+        trial.main(["--check", str(path)])
+    lines = capsys.readouterr().out.splitlines()
+    assert stop.value.code == 1
+    assert lines[1].endswith("as kept: True; T3 cells as kept: True")
+    assert lines[2].endswith("as kept: False; T3 cells as kept: True")
 
 
 def test_the_profile_trials_kept_file_is_what_its_text_and_the_docs_quote():
-    """The kept load-friction profile: run on the twelfth refit's kept file, complete, its five values in the order
-    run, and the printed costs and 13.5 g vertical T3 cells those of its results (docs/investigations.md quotes
-    them)."""
+    """The kept load-friction profile: run on the twelfth refit's preset (its digest and its cut), complete, its five
+    values in the order run, and the printed costs and 13.5 g vertical T3 cells those of its results, which
+    docs/investigations.md quotes."""
     import json
+
+    from twin.plants.as_built import TWELFTH_REFIT_FILE, calibration_cost_line, preset_digest
 
     folder = ROOT / "examples" / "trial_profile_likelihood"
     kept = json.loads((folder / "load_friction.json").read_text())
     printed = (folder / "load_friction.txt").read_text()
-    assert kept["preset"] == "6bb9e9258023" and kept["complete"] and len(kept["evaluations"]) == 120
+    assert kept["preset"] == preset_digest(TWELFTH_REFIT_FILE) == "6bb9e9258023"
+    assert kept["cut"] == sum(calibration_cost_line(TWELFTH_REFIT_FILE))
+    assert kept["complete"] and len(kept["evaluations"]) == 120
     assert [r["at"] for r in kept["results"]] == [0.40, 0.45, 0.50, 0.10, 0.05]
     costs = [float(c) for c in re.findall(r"^  cost (\d\.\d+) \(", printed, re.M)]
     assert costs == [round(r["cost"], 4) for r in kept["results"]]
+    shown = re.findall(r"^    T3 (\w+) +13\.5 g vertical +(\d\.\d\d) ", printed, re.M)
+    assert [f"{a[1]} / {b[1]}" for a, b in zip(shown[::2], shown[1::2], strict=True)] == [
+        "4.28 / 4.09", "4.87 / 4.50", "5.51 / 4.90", "3.11 / 2.79", "3.09 / 2.75"]
     assert [r["under_cut"] for r in kept["results"]] == [True, True, False, False, True]
     assert all(r["under_cut"] == (r["cost"] <= kept["cut"]) for r in kept["results"])
     for r in kept["results"]:  # each value's result is the lowest of its own evaluations
