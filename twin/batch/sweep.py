@@ -262,11 +262,11 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
             on_done(cluster(ray.get, done[0]))
     finally:  # best effort: a cluster already lost refuses these too, and must not hide why the sweep stopped
         with contextlib.suppress(ConnectionError):
-            for ref in pending:
-                ray.cancel(ref)
-        if started_here:
-            with contextlib.suppress(ConnectionError):
-                ray.shutdown()
+            if started_here:  # the job ends here, and its tasks with it: no cancel, which raced the tasks' replies
+                ray.shutdown()  # (a stop then crashed the sweep with Ray's "task that was not pending", 5 of 31)
+            else:  # the caller's Ray lives on: these tasks would run on in it
+                for ref in pending:
+                    ray.cancel(ref)
 
 
 def counting(bar) -> Callable[[int], None]:
