@@ -146,7 +146,9 @@ def main(argv: list[str] | None = None) -> None:
         if args.out is not None:
             parser.error("--out keeps a profile run now (--at); --check writes nothing")
         kept = read_json(parser, args.check, "--check")
-        if not isinstance(kept.get("results"), list) or not kept["results"] or "preset" not in kept:
+        results = kept.get("results")
+        if not isinstance(results, list) or not results or "preset" not in kept or not all(
+                isinstance(r, dict) and {"at", "parameter", "cost", "values", "t3"} <= set(r) for r in results):
             parser.error(f"--check {args.check}: not a kept profile trial file (no results)")
         if not check(kept, args.check, args.workers):
             sys.exit(1)
@@ -157,24 +159,30 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"--at {outside[0]:g}: {args.parameter} must lie in its box, {box.low:g}-{box.high:g}")
     if args.evaluations < len(FITTED):
         parser.error(f"--evaluations {args.evaluations}: the first simplex alone needs {len(FITTED)}")
-    if args.out is not None and args.out.exists():
-        parser.error(f"{args.out} is there already: give another --out")
+    part = None if args.out is None else args.out.with_name(args.out.name + ".part")
+    if args.out is not None and (args.out.exists() or part.exists()):
+        parser.error(f"{args.out if args.out.exists() else part} is there already: give another --out")
     if args.out is not None and not args.out.parent.is_dir():
         parser.error(f"{args.out.parent} is not a folder")
     path = TWELFTH_REFIT_FILE if args.calibration is None else args.calibration
     data = read_json(parser, path, "--calibration")
-    ensemble = data.get("ensemble")
-    if not isinstance(ensemble, list) or not ensemble or not all(
-            isinstance(m, dict) and set(names) <= set(m.get("values", {})) for m in ensemble):
-        parser.error(f"--calibration {path}: not a calibration file with an ensemble of the fitted parameters")
     try:
         best, noise = calibration_cost_line(path)
-    except TwinError as error:
-        parser.error(f"--calibration {path}: {error}")
+        members = [({**m["values"]}, float(m["cost"])) for m in data["ensemble"]]
+        if not members or not all(set(names) <= set(m) for m, _ in members):
+            raise KeyError("the fitted parameters")
+        digest = preset_digest(path)
+    except (TwinError, KeyError, TypeError, ValueError) as error:
+        parser.error(f"--calibration {path}: not a calibration file with an ensemble of the fitted parameters "
+                     f"({error.__class__.__name__})")
+    if part is not None:
+        try:  # found out now, not after the whole run
+            part.write_text("")
+        except OSError as error:
+            parser.error(f"--out {args.out}: cannot write beside it ({error.strerror})")
     cut = best + noise
-    members = [({**m["values"]}, float(m["cost"])) for m in data["ensemble"]]
     lows = [m[0][args.parameter] for m in members]
-    print(f"preset {preset_digest(path)}: cut {cut:.4f} (cost {best:.4f} + noise {noise:.4f}); the ensemble's "
+    print(f"preset {digest}: cut {cut:.4f} (cost {best:.4f} + noise {noise:.4f}); the ensemble's "
           f"{args.parameter} {min(lows):.4g}-{max(lows):.4g}; each value refitted over {args.evaluations} evaluations "
           f"of the other {len(FITTED) - 1}, fit seeds {calibrate.FIT_SEEDS[0]}-{calibrate.FIT_SEEDS[-1]}")
     rows = [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
@@ -207,17 +215,21 @@ def main(argv: list[str] | None = None) -> None:
                           f"{span.min():.2f}-{span.max():.2f}{outside_span}", flush=True)
                 print(f"    sliding mode ahead in {ahead} of 6 T3 cells", flush=True)
     finally:
-        if args.out is not None and log:
-            part = args.out.with_name(args.out.name + ".part")
-            part.write_text(json.dumps({"calibration": str(path), "preset": preset_digest(path), "cut": cut,
-                                        "evaluations_per_value": args.evaluations, "results": results,
-                                        "evaluations": log, "wall_time_s": time.perf_counter() - started,
-                                        "complete": len(results) == len(args.at)}, indent=1) + "\n")
-            if args.out.exists():  # it appeared while the trial ran: not replaced
-                print(f"{args.out} appeared while the trial ran; kept its results in {part}", file=sys.stderr)
-            else:
-                part.replace(args.out)
-                print(f"wrote {args.out}", file=sys.stderr)
+        if part is not None and not log:
+            part.unlink(missing_ok=True)  # nothing ran: no file
+        elif part is not None:
+            try:
+                part.write_text(json.dumps({"calibration": str(path), "preset": digest, "cut": cut,
+                                            "evaluations_per_value": args.evaluations, "results": results,
+                                            "evaluations": log, "wall_time_s": time.perf_counter() - started,
+                                            "complete": len(results) == len(args.at)}, indent=1) + "\n")
+                if args.out.exists():  # it appeared while the trial ran: not replaced
+                    print(f"{args.out} appeared while the trial ran; kept its results in {part}", file=sys.stderr)
+                else:
+                    part.replace(args.out)
+                    print(f"wrote {args.out}", file=sys.stderr)
+            except OSError as error:  # said, and not in place of why the run stopped
+                print(f"could not keep the results in {args.out}: {error}", file=sys.stderr)
     print(f"{len(log)} evaluations in {time.perf_counter() - started:.0f} s")
 
 

@@ -1134,6 +1134,7 @@ def test_the_twelfth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
     (["--check", "kept.json", "--out", "y.json"], "--out keeps a profile run now (--at); --check writes nothing"),
     (["--at", "0.4", "--calibration", "missing.json"], "--calibration missing.json: cannot read it as JSON"),
     (["--at", "0.4", "--calibration", "kept.json"], "--calibration kept.json: not a calibration file with an ensemble"),
+    (["--at", "0.4", "--out", "x.json"], "x.json.part is there already: give another --out"),
 ])
 def test_the_profile_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch, tmp_path, argv, said):
     """A value outside the parameter's box, a budget under the first simplex, an --out that is there already or in no
@@ -1148,6 +1149,7 @@ def test_the_profile_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch,
     monkeypatch.chdir(tmp_path)
     (tmp_path / "kept.json").write_text("{}")
     (tmp_path / "broken.json").write_text("{")
+    (tmp_path / "x.json.part").write_text("")  # a part kept by a run before
     with pytest.raises(SystemExit) as stop:
         _load("trial_profile_likelihood").main(argv)
     err = capsys.readouterr().err
@@ -1226,9 +1228,14 @@ def test_the_profile_trials_kept_file_is_what_its_text_and_the_docs_quote():
 
 @pytest.mark.slow  # about 1 min on 2 cores: five parameter sets on the fit's 21 cells x 10 seeds and T3's 12 x 5
 def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys):
-    _load("trial_profile_likelihood").main(["--check", str(ROOT / "examples" / "trial_profile_likelihood" /
-                                                              "load_friction.json")])
+    try:  # exit 1 on a mismatch: the lines below then say which
+        _load("trial_profile_likelihood").main(["--check", str(ROOT / "examples" / "trial_profile_likelihood" /
+                                                                  "load_friction.json")])
+        code = 0
+    except SystemExit as stop:
+        code = stop.code
     lines = capsys.readouterr().out.splitlines()
+    assert code == 0, lines
     assert lines[0].endswith("preset 6bb9e9258023, 5 values of load_friction")
     assert [line.split(":")[0].strip() for line in lines[1:]] == ["0.4", "0.45", "0.5", "0.1", "0.05"]
     assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines

@@ -262,8 +262,8 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
             on_done(cluster(ray.get, done[0]))
     finally:  # best effort: a cluster already lost refuses these too, and must not hide why the sweep stopped
         with contextlib.suppress(ConnectionError):
-            if started_here:  # the job ends here, and its tasks with it: no cancel, which raced the tasks' replies
-                ray.shutdown()  # (a stop then crashed the sweep with Ray's "task that was not pending", 5 of 31)
+            if started_here:  # the job ends here (a joined cluster's clean-up of a finished job ends its tasks): no
+                ray.shutdown()  # cancel, which raced the tasks' replies (Ray then crashed a stopped sweep, 5 of 31)
             else:  # the caller's Ray lives on: these tasks would run on in it
                 for ref in pending:
                     ray.cancel(ref)
