@@ -34,6 +34,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import pathlib
 import sys
 import time
@@ -43,7 +44,14 @@ import numpy as np
 from twin.exceptions import TwinError
 from twin.experiments import calibrate
 from twin.experiments.validate import PREDICTION_CELLS, SEEDS, lead_counts, rmse_within
-from twin.plants.as_built import FITTED, TWELFTH_REFIT_FILE, calibration_cost_line, preset_digest
+from twin.plants.as_built import (
+    FITTED,
+    TWELFTH_REFIT_FILE,
+    calibration_cost_line,
+    ensemble_costs,
+    ensemble_values,
+    preset_digest,
+)
 
 STEP = 0.10  # the initial simplex's step per refitted parameter, in unit-box coordinates (into the box)
 EVALUATIONS = 24  # per point: twin calibrate's simplex budget
@@ -165,16 +173,15 @@ def main(argv: list[str] | None = None) -> None:
     if args.out is not None and not args.out.parent.is_dir():
         parser.error(f"{args.out.parent} is not a folder")
     path = TWELFTH_REFIT_FILE if args.calibration is None else args.calibration
-    data = read_json(parser, path, "--calibration")
-    try:
+    read_json(parser, path, "--calibration")  # a file that is not JSON, said as --check says it
+    try:  # the as-built readers' checks: every member's values in the box, the cost line finite
         best, noise = calibration_cost_line(path)
-        members = [({**m["values"]}, float(m["cost"])) for m in data["ensemble"]]
-        if not members or not all(set(names) <= set(m) for m, _ in members):
-            raise KeyError("the fitted parameters")
+        costs = [math.inf if c is None else c for c in ensemble_costs(path)]  # no cost: the last of a tie
+        members = list(zip(ensemble_values(path), costs, strict=True))
         digest = preset_digest(path)
-    except (TwinError, KeyError, TypeError, ValueError) as error:
+    except TwinError as error:
         parser.error(f"--calibration {path}: not a calibration file with an ensemble of the fitted parameters "
-                     f"({error.__class__.__name__})")
+                     f"({str(error).splitlines()[0]})")
     if part is not None:
         try:  # found out now, not after the whole run
             part.write_text("")

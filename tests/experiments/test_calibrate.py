@@ -170,14 +170,17 @@ def test_record_keeps_the_ensemble_and_the_noise_and_the_table_and_plot_show_the
     assert (tmp_path / "c.png").stat().st_size > 0
 
 
-def _start_angle_refits() -> list[dict]:
-    """The package's copy of the start-angle trial sets (twin calibrate's further starts 7-16)."""
-    return json.loads(calibrate.START_ANGLE_REFITS_FILE.read_text())["starts"]
+def _starts(package_file) -> list[dict]:
+    """A package copy of a trial's sets that twin calibrate takes as further starts (calibrate's
+    START_PRESSURE_REFITS_FILE: starts 3-6; START_ANGLE_REFITS_FILE: 7-16; PROFILE_REFITS_FILE: 17-19)."""
+    return json.loads(package_file.read_text())["starts"]
 
 
-def _profile_refits() -> list[dict]:
-    """The package's copy of the load-friction profile trial's sets (twin calibrate's last three further starts)."""
-    return json.loads(calibrate.PROFILE_REFITS_FILE.read_text())["starts"]
+def _same_fit_but_for_the_new_starts(new: dict, old: dict, starts: list[dict]) -> None:
+    """The calibration file ``new`` is ``old`` with the further starts ``starts`` (values) added to its history,
+    every other row value for value and cost for cost in order, so with the same fitted values, cost and noise."""
+    assert [h for h in new["history"] if not (h["stage"] == "previous" and h["values"] in starts)] == old["history"]
+    assert (new["fitted"], new["cost"], new["noise"]) == (old["fitted"], old["cost"], old["noise"])
 
 
 def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_one_outside_is_refused():
@@ -197,7 +200,7 @@ def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_on
     ninth, tenth = (json.loads(f.read_text()) for f in (NINTH_REFIT_FILE, TENTH_REFIT_FILE))
     assert preset_digest(NINTH_REFIT_FILE) == "57ff10bf5b36"  # the ninth refit's file, as committed on 2026-11-26
     assert preset_digest(TENTH_REFIT_FILE) == "1c2dcd8c9f7f"  # the tenth's, as committed on 2026-11-27
-    kept = json.loads(calibrate.START_PRESSURE_REFITS_FILE.read_text())["starts"]
+    kept = _starts(calibrate.START_PRESSURE_REFITS_FILE)
     trials = []
     for start, fraction in zip(kept, (0.0, 0.25, 0.75, 1.0), strict=True):
         source = ROOT / start["source"]
@@ -207,23 +210,24 @@ def test_the_further_starts_are_the_earlier_fits_as_fitted_inside_the_box_and_on
         assert start["cost"] == fit["cost"]
         trials.append({**fit["fitted"], "initial_pressure_fraction": fraction})
     angles, cut = [], sum(calibration_cost_line(ELEVENTH_REFIT_FILE))  # the eleventh refit's best + noise
-    for start in _start_angle_refits():  # its members under that cut from 30 deg, at their exact values
+    angle_starts, profile_starts = _starts(calibrate.START_ANGLE_REFITS_FILE), _starts(calibrate.PROFILE_REFITS_FILE)
+    for start in angle_starts:  # its members under that cut from 30 deg, at their exact values
         source = ROOT / start["source"]
         assert hashlib.sha256(source.read_bytes()).hexdigest() == start["source_sha256"]
         member = json.loads(source.read_text())["ensemble"][start["member"]]
         assert start["values"] == member["values"] and start["cost_from_30_deg"] <= cut
         angles.append(member["values"])
-    assert [(s["source"][-7:-5], s["member"]) for s in _start_angle_refits()] == [
+    assert [(s["source"][-7:-5], s["member"]) for s in angle_starts] == [
         *(("20", m) for m in (4, 5, 6, 7, 8, 10, 11, 12)), ("25", 11), ("25", 12)]
     profiles, cut = [], sum(calibration_cost_line(TWELFTH_REFIT_FILE))  # the twelfth refit's best + noise
-    for start in _profile_refits():  # the profile trial's refits under that cut, at their exact values
+    for start in profile_starts:  # the profile trial's refits under that cut, at their exact values
         source = ROOT / start["source"]
         assert hashlib.sha256(source.read_bytes()).hexdigest() == start["source_sha256"]
         (result,) = [r for r in json.loads(source.read_text())["results"] if r["at"] == start["load_friction"]]
         assert start["values"] == result["values"] and start["cost"] == result["cost"] <= cut
         assert start["values"]["load_friction"] == start["load_friction"]
         profiles.append(result["values"])
-    assert [s["load_friction"] for s in _profile_refits()] == [0.40, 0.45, 0.05]
+    assert [s["load_friction"] for s in profile_starts] == [0.40, 0.45, 0.05]
     half = {"initial_pressure_fraction": 0.5}
     assert calibrate.previous_fits() == ({**ninth["fitted"], **half}, {**tenth["fitted"], **half}, *trials, *angles,
                                          *profiles)
@@ -256,11 +260,11 @@ def test_the_committed_file_holds_the_further_starts_as_evaluated_and_its_ensemb
     assert stages[first:first + 19] == ["previous"] * 19 and "simplex" not in stages[first:] and "profile" not in stages[:first]
     assert [r["values"] for r in rows] == list(calibrate.previous_fits())
     kept = [json.loads(f.read_text())["cost"] for f in (NINTH_REFIT_FILE, TENTH_REFIT_FILE)] + [
-        t["cost"] for t in json.loads(calibrate.START_PRESSURE_REFITS_FILE.read_text())["starts"]]
+        t["cost"] for t in _starts(calibrate.START_PRESSURE_REFITS_FILE)]
     assert [r["cost"] for r in rows[:6]] == pytest.approx(kept, rel=1e-12)
-    printed = [t["cost_from_30_deg"] for t in _start_angle_refits()]
+    printed = [t["cost_from_30_deg"] for t in _starts(calibrate.START_ANGLE_REFITS_FILE)]
     assert [r["cost"] for r in rows[6:16]] == pytest.approx(printed, abs=5e-5)
-    assert [r["cost"] for r in rows[16:]] == pytest.approx([t["cost"] for t in _profile_refits()], rel=1e-12)
+    assert [r["cost"] for r in rows[16:]] == pytest.approx([t["cost"] for t in _starts(calibrate.PROFILE_REFITS_FILE)], rel=1e-12)
     assert all(r["cost"] <= committed["cost"] + committed["noise"]["std"] for r in rows)  # within the noise
     members = [m["values"] for m in committed["ensemble"]]
     assert all(r["values"] in members for r in rows[:6])
@@ -279,9 +283,8 @@ def test_the_twelfth_refit_is_the_eleventh_with_ten_more_starts():
     from twin.plants.as_built import ELEVENTH_REFIT_FILE, TWELFTH_REFIT_FILE
 
     twelfth, eleventh = (json.loads(f.read_text()) for f in (TWELFTH_REFIT_FILE, ELEVENTH_REFIT_FILE))
-    angles = [s["values"] for s in _start_angle_refits()]
-    assert [h for h in twelfth["history"] if not (h["stage"] == "previous" and h["values"] in angles)] == eleventh["history"]
-    assert (twelfth["fitted"], twelfth["cost"], twelfth["noise"]) == (eleventh["fitted"], eleventh["cost"], eleventh["noise"])
+    angles = [s["values"] for s in _starts(calibrate.START_ANGLE_REFITS_FILE)]
+    _same_fit_but_for_the_new_starts(twelfth, eleventh, angles)
     new = [m["values"] for m in twelfth["ensemble"] if m not in eleventh["ensemble"]]
     assert new == [angles[8], angles[9]] and len(twelfth["ensemble"]) == len(eleventh["ensemble"]) == 13
 
@@ -294,13 +297,11 @@ def test_the_thirteenth_refit_is_the_twelfth_with_three_more_starts():
     from twin.plants.as_built import TWELFTH_REFIT_FILE
 
     thirteenth, twelfth = (json.loads(f.read_text()) for f in (CALIBRATION_FILE, TWELFTH_REFIT_FILE))
-    profiles = [s["values"] for s in _profile_refits()]
+    profiles = [s["values"] for s in _starts(calibrate.PROFILE_REFITS_FILE)]
     history = thirteenth["history"]
-    assert [h for h in history if not (h["stage"] == "previous" and h["values"] in profiles)] == twelfth["history"]
+    _same_fit_but_for_the_new_starts(thirteenth, twelfth, profiles)
     first = [h["stage"] for h in history].index("previous")
     assert [h["values"] for h in history[first + 16:first + 19]] == profiles
-    assert (thirteenth["fitted"], thirteenth["cost"], thirteenth["noise"]) == (
-        twelfth["fitted"], twelfth["cost"], twelfth["noise"])
     members = [m["values"] for m in thirteenth["ensemble"]]
     assert profiles[1] in members and profiles[2] in members  # the highest load friction under the cut, the lowest
     lows = [m["load_friction"] for m in members]

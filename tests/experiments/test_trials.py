@@ -1162,13 +1162,12 @@ def test_the_profile_trials_check_exits_1_when_a_kept_number_is_not_run_again(ca
     import json
 
     kept = json.loads((ROOT / "examples" / "trial_profile_likelihood" / "load_friction.json").read_text())
+    original = {r["at"]: {**r} for r in kept["results"]}  # copies: the edit below is the file's only
     kept["results"] = kept["results"][:2]
     kept["results"][1]["cost"] += 1e-15
     path = tmp_path / "kept.json"
     path.write_text(json.dumps(kept))
     trial = _load("trial_profile_likelihood")
-    original = {r["at"]: r for r in json.loads(
-        (ROOT / "examples" / "trial_profile_likelihood" / "load_friction.json").read_text())["results"]}
 
     class Stub:
         def __init__(self, **kwargs):
