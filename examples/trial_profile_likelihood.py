@@ -13,20 +13,28 @@ a point over it shows only that this search found none. For each refit it prints
 refitted values, the measured RMSE cells within 20 % on seeds 0-4, and the twelve T3 cells (seeds 0-4, as
 ``twin validate`` runs them) beside the ensemble's members' range.
 
-The calibration file is the twelfth refit's, which it first ran on (``twin/plants/data/twelfth_refit.json``, digest
-6bb9e9258023), unless ``--calibration`` names another; its preset digest is printed. Nothing is installed or
-refitted in the package, and no T3 measurement was seen. ``--out FILE`` keeps every evaluation and each point's
-result as JSON (written whole once the trial ends, refused if the file is there; on a stop, what ran is written
-before it stops). ``--check FILE`` runs a kept file's results again (each value's refitted set on the fit seeds, and
-its T3 cells) and prints whether they give the kept costs and cells, in about a minute; it exits 1 if any does not.
+The calibration file is the committed one (``twin/plants/data/as_built.json``) unless ``--calibration`` names
+another; its preset digest is printed. Nothing is installed or refitted in the package, and no T3 measurement was
+seen. ``--out FILE`` keeps every evaluation and each point's result as JSON (written whole once the trial ends,
+refused if the file is there; on a stop, what ran is written before it stops). ``--check FILE`` runs a kept file's
+results again (each value's refitted set on the fit seeds, and its T3 cells) and prints whether they give the kept
+costs and cells, in about a minute; it exits 1 if any does not.
 
-On 2026-11-28 (stop 46) it ran the load friction at 0.40, 0.45, 0.50, 0.10 and 0.05 N/N (120 evaluations, 543 s on
-2 cores): ``examples/trial_profile_likelihood/load_friction.json`` and ``.txt`` (what it printed; the file's
-``calibration`` names the committed file as it then was, the twelfth refit, whose digest it keeps). The results are
-recorded in docs/investigations.md; the sets under the cut are further starts of ``twin calibrate`` since file
-version 11 (``twin/plants/data/profile_refits.json``).
+On 2026-11-28 (stop 46) it ran the load friction at 0.40, 0.45, 0.50, 0.10 and 0.05 N/N on the twelfth refit
+(``--calibration twin/plants/data/twelfth_refit.json``, digest 6bb9e9258023; 120 evaluations, 543 s on 2 cores):
+``examples/trial_profile_likelihood/load_friction.json`` and ``.txt`` (what it printed; the file's ``calibration``
+names the committed file as it then was, the twelfth refit, whose digest it keeps). The sets under the cut are
+further starts of ``twin calibrate`` since file version 11 (``twin/plants/data/profile_refits.json``). On
+2026-11-28 (stop 47) it ran the breakaway, the leak, the free air and then the observer gain on the thirteenth
+refit, the committed one (digest 13aadbb61885), each file beside the first: ``stiction``, ``leak_conductance``,
+``air_fraction`` and ``observer_gain``. Every result is recorded in docs/investigations.md.
 
-    python examples/trial_profile_likelihood.py --parameter load_friction --at 0.40 0.45 0.50 0.10 0.05 --out FILE
+    python examples/trial_profile_likelihood.py --parameter load_friction --at 0.40 0.45 0.50 0.10 0.05 \
+        --calibration twin/plants/data/twelfth_refit.json --out FILE
+    python examples/trial_profile_likelihood.py --parameter stiction --at 2.1 2.35 2.55 1.0 --out FILE
+    python examples/trial_profile_likelihood.py --parameter leak_conductance --at 1e-14 5e-15 0 3e-14 --out FILE
+    python examples/trial_profile_likelihood.py --parameter air_fraction --at 0.02 0.01 0.065 0.08 --out FILE
+    python examples/trial_profile_likelihood.py --parameter observer_gain --at 250 150 700 900 --out FILE
     python examples/trial_profile_likelihood.py --check examples/trial_profile_likelihood/load_friction.json
 """
 
@@ -45,8 +53,8 @@ from twin.exceptions import TwinError
 from twin.experiments import calibrate
 from twin.experiments.validate import PREDICTION_CELLS, SEEDS, lead_counts, rmse_within
 from twin.plants.as_built import (
+    CALIBRATION_FILE,
     FITTED,
-    TWELFTH_REFIT_FILE,
     calibration_cost_line,
     ensemble_costs,
     ensemble_values,
@@ -143,7 +151,7 @@ def main(argv: list[str] | None = None) -> None:
                         help="its values (SI, as the calibration file), each inside its box; run in the order given")
     parser.add_argument("--check", type=pathlib.Path, metavar="FILE", help="run a kept trial file's results again")
     parser.add_argument("--calibration", type=pathlib.Path, default=None, help="the calibration file (default: the "
-                        "twelfth refit's kept file)")
+                        "committed one)")
     parser.add_argument("--evaluations", type=int, default=EVALUATIONS, help="refit budget per value")
     parser.add_argument("--out", type=pathlib.Path, metavar="FILE", help="keep the evaluations and results as JSON")
     parser.add_argument("--workers", type=int, default=2)
@@ -172,7 +180,7 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"{args.out if args.out.exists() else part} is there already: give another --out")
     if args.out is not None and not args.out.parent.is_dir():
         parser.error(f"{args.out.parent} is not a folder")
-    path = TWELFTH_REFIT_FILE if args.calibration is None else args.calibration
+    path = CALIBRATION_FILE if args.calibration is None else args.calibration
     read_json(parser, path, "--calibration")  # a file that is not JSON, said as --check says it
     try:  # the as-built readers' checks: every member's values in the box, the cost line finite
         best, noise = calibration_cost_line(path)

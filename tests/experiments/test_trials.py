@@ -1240,6 +1240,88 @@ def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys):
     assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
 
 
+# The stop-47 profiles, on the thirteenth refit: each file's values in the order run, which were under the cut, and
+# the 13.5 g vertical T3 cells (FF + PVA / sliding mode) as printed and as docs/investigations.md quotes them.
+STOP_47_PROFILES = {
+    "stiction": ([2.1, 2.35, 2.55, 1.0], [False, False, False, True],
+                 ["11.06 / 8.34", "16.14 / 13.34", "26.65 / 26.61", "3.61 / 3.42"]),
+    "leak_conductance": ([1e-14, 5e-15, 0.0, 3e-14], [True, True, False, True],
+                         ["3.36 / 3.38", "3.59 / 3.38", "3.70 / 3.50", "4.16 / 3.81"]),
+    "air_fraction": ([0.02, 0.01, 0.065, 0.08], [True, False, True, False],
+                     ["3.78 / 3.94", "4.97 / 4.84", "3.91 / 3.56", "4.26 / 3.68"]),
+    "observer_gain": ([250.0, 150.0, 700.0, 900.0], [False, False, False, False],
+                      ["3.56 / 3.49", "3.31 / 3.32", "4.21 / 3.95", "4.34 / 3.92"]),
+}
+
+
+@pytest.mark.parametrize("name", list(STOP_47_PROFILES))
+def test_the_stop_47_profile_files_are_what_their_text_and_the_docs_quote(name):
+    """The breakaway, leak, free-air and observer-gain profiles: run on the thirteenth refit's preset (the committed one: its digest
+    and its cut), complete, the values in the order run, each result the lowest of its own 24 evaluations, and the
+    printed costs and 13.5 g vertical T3 cells those of the results."""
+    import json
+
+    from twin.plants.as_built import CALIBRATION_FILE, calibration_cost_line, preset_digest
+
+    at, under, vertical = STOP_47_PROFILES[name]
+    folder = ROOT / "examples" / "trial_profile_likelihood"
+    kept = json.loads((folder / f"{name}.json").read_text())
+    printed = (folder / f"{name}.txt").read_text()
+    assert kept["preset"] == preset_digest(CALIBRATION_FILE) == "13aadbb61885"
+    assert kept["cut"] == sum(calibration_cost_line(CALIBRATION_FILE))
+    assert kept["complete"] and len(kept["evaluations"]) == 24 * len(at)
+    assert [r["parameter"] for r in kept["results"]] == [name] * len(at)
+    assert [r["at"] for r in kept["results"]] == at
+    assert [r["under_cut"] for r in kept["results"]] == under
+    assert all(r["under_cut"] == (r["cost"] <= kept["cut"]) for r in kept["results"])
+    for r in kept["results"]:
+        own = [e["cost"] for e in kept["evaluations"] if e["at"] == r["at"]]
+        assert len(own) == 24 and r["cost"] == min(own) and r["values"][name] == r["at"]
+    costs = [float(c) for c in re.findall(r"^  cost (\d\.\d+) \(", printed, re.M)]
+    assert costs == [round(r["cost"], 4) for r in kept["results"]]
+    shown = re.findall(r"^    T3 (\w+) +13\.5 g vertical +(\d+\.\d\d) ", printed, re.M)
+    assert [f"{a[1]} / {b[1]}" for a, b in zip(shown[::2], shown[1::2], strict=True)] == vertical
+    means = [[t["twin_mean"] for t in r["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]
+             for r in kept["results"]]
+    assert [f"{a:.2f} / {b:.2f}" for a, b in means] == vertical
+
+
+@pytest.mark.slow  # about 1 min on 2 cores each: four parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
+@pytest.mark.parametrize("name", list(STOP_47_PROFILES))
+def test_the_stop_47_profiles_kept_results_run_again_to_the_last_bit(capsys, name):
+    try:  # exit 1 on a mismatch: the lines below then say which
+        _load("trial_profile_likelihood").main(["--check", str(ROOT / "examples" / "trial_profile_likelihood" /
+                                                                  f"{name}.json")])
+        code = 0
+    except SystemExit as stop:
+        code = stop.code
+    lines = capsys.readouterr().out.splitlines()
+    assert code == 0, lines
+    assert lines[0].endswith(f"preset 13aadbb61885, 4 values of {name}")
+    assert [float(line.split(":")[0]) for line in lines[1:]] == STOP_47_PROFILES[name][0]
+    assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
+
+
+@pytest.mark.slow  # about 20 s on 2 cores: nine parameter sets on the eleven Chapter 5 cells x 5 seeds
+def test_the_profile_orders_trial_prints_what_it_kept(capsys):
+    _load("trial_profile_orders").main()
+    kept = (ROOT / "examples" / "trial_profile_likelihood" / "orders.txt").read_text()
+    assert capsys.readouterr().out == kept
+
+
+def test_the_profile_orders_kept_text_pairs_each_reversed_t3_lead_with_a_wrong_chapter_5_order():
+    """What docs/investigations.md reads from orders.txt: every refit under the cut with the measured Chapter 5
+    order on all four trajectories has sliding mode ahead in all six T3 cells, and every one with FF + PVA ahead in
+    a T3 cell gets one or more trajectories' order wrong; nine refits, five with the order right on all four."""
+    lines = (ROOT / "examples" / "trial_profile_likelihood" / "orders.txt").read_text().splitlines()[1:]
+    found = [(int(a), int(b)) for a, b in (re.search(r"order right on (\d) of 4.*ahead in (\d) of 6", line).groups()
+                                           for line in lines)]
+    assert len(found) == 9 and sum(right == 4 for right, _ in found) == 5
+    assert all(ahead == 6 for right, ahead in found if right == 4)
+    assert sorted(ahead for right, ahead in found if ahead < 6) == [0, 2, 3]
+    assert all(right < 4 for right, ahead in found if ahead < 6)
+
+
 @pytest.mark.parametrize(("heading", "folder", "member_count"), [
     ("## Beside the fifth: T3 on a trial refit", "trial_air_box", 11),
     ("## Fifth blind prediction: T3 on the ninth refit", "ninth_refit_prediction", 9),  # superseded, kept as packaged
