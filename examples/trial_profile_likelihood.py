@@ -27,7 +27,10 @@ names the committed file as it then was, the twelfth refit, whose digest it keep
 further starts of ``twin calibrate`` since file version 11 (``twin/plants/data/profile_refits.json``). On
 2026-11-28 (stop 47) it ran the breakaway, the leak, the free air and then the observer gain on the thirteenth
 refit, the committed one (digest 13aadbb61885), each file beside the first: ``stiction``, ``leak_conductance``,
-``air_fraction`` and ``observer_gain``. Every result is recorded in docs/investigations.md.
+``air_fraction`` and ``observer_gain``. The first three were given ``--calibration twin/plants/data/as_built.json``,
+the file the default reads; the fourth ran on the default, and its file names it by the absolute path of the
+checkout it ran in (kept files name it from the checkout's root since). Every result is recorded in
+docs/investigations.md.
 
     python examples/trial_profile_likelihood.py --parameter load_friction --at 0.40 0.45 0.50 0.10 0.05 \
         --calibration twin/plants/data/twelfth_refit.json --out FILE
@@ -61,6 +64,7 @@ from twin.plants.as_built import (
     preset_digest,
 )
 
+ROOT = pathlib.Path(__file__).resolve().parent.parent  # the checkout
 STEP = 0.10  # the initial simplex's step per refitted parameter, in unit-box coordinates (into the box)
 EVALUATIONS = 24  # per point: twin calibrate's simplex budget
 MEASURED_SEEDS = SEEDS  # the verdict's five runs, cut from the fit's ten
@@ -141,6 +145,14 @@ def check(kept: dict, path: pathlib.Path, workers: int) -> bool:
             same = same and all(both)
             print(f"  {result['at']:g}: cost {cost:.4f}, as kept: {both[0]}; T3 cells as kept: {both[1]}", flush=True)
     return same
+
+
+def shown(path) -> str:
+    """``path`` as a kept file names it: from the checkout's root when it lies in it, else as given."""
+    try:
+        return str(pathlib.Path(str(path)).resolve().relative_to(ROOT))
+    except ValueError:
+        return str(path)
 
 
 def main(argv: list[str] | None = None) -> None:
@@ -234,7 +246,7 @@ def main(argv: list[str] | None = None) -> None:
             part.unlink(missing_ok=True)  # nothing ran: no file
         elif part is not None:
             try:
-                part.write_text(json.dumps({"calibration": str(path), "preset": digest, "cut": cut,
+                part.write_text(json.dumps({"calibration": shown(path), "preset": digest, "cut": cut,
                                             "evaluations_per_value": args.evaluations, "results": results,
                                             "evaluations": log, "wall_time_s": time.perf_counter() - started,
                                             "complete": len(results) == len(args.at)}, indent=1) + "\n")

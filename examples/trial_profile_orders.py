@@ -3,56 +3,83 @@
 The cost ``twin calibrate`` fits and cuts the ensemble by weighs each measured cell's RMSE and SSE; it does not ask
 whether the controllers come out in the measured order. The profile trial (``examples/trial_profile_likelihood.py``)
 found sets under the cut with FF + PVA ahead of sliding mode in up to all six T3 cells, where the committed preset
-has sliding mode ahead in all six. This prints, for every refit under the cut in the kept profile files
-(``examples/trial_profile_likelihood/*.json``, in name order, each file's values in the order run), the Chapter 5
-cells' order per trajectory on seeds 0-4 (as ``twin validate`` ranks them) against the measured order, and how many
-of the six T3 cells sliding mode leads in the kept file. Nothing is fitted or installed; no T3 measurement was seen.
+has sliding mode ahead in all six. This prints, for every refit under the cut in the kept profile files given (by
+default every ``examples/trial_profile_likelihood/*.json``, in name order; each file's values in the order run, after
+a line naming the file and the preset it ran on), the Chapter 5 cells' order per trajectory on seeds 0-4 (as ``twin
+validate`` ranks them) against the measured order, and how many of the six T3 cells sliding mode leads in the kept
+file. A file that is not a complete kept profile run is refused in one line, before any run. Nothing is fitted or
+installed; no T3 measurement was seen.
 
-On 2026-11-28 (stop 47) its output was kept as ``examples/trial_profile_likelihood/orders.txt``; docs/investigations.md
-quotes it, and a slow test runs it again and gets that text.
+On 2026-11-28 (stop 47) its output on the five kept files was kept as
+``examples/trial_profile_likelihood/orders.txt``; docs/investigations.md quotes it, and a slow test runs it again
+and gets that text.
 
-    python examples/trial_profile_orders.py
+    python examples/trial_profile_orders.py [FILE ...] [--workers 2]
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 import pathlib
 
 from twin.experiments import calibrate
-from twin.experiments.validate import PREDICTION_CELLS, SEEDS, _known_orders, _order, lead_counts
+from twin.experiments.validate import PREDICTION_CELLS, SEEDS, controller_order, known_orders, lead_counts
 
 KEPT = pathlib.Path(__file__).resolve().parent / "trial_profile_likelihood"
 
 
-def under_cut_refits(folder: pathlib.Path = KEPT) -> list[tuple[str, dict]]:
-    """(label, result) of every kept refit under its file's cut, files in name order, values in the order run."""
-    out = []
-    for path in sorted(folder.glob("*.json")):
-        for result in json.loads(path.read_text())["results"]:
-            if result["under_cut"]:
-                out.append((f"{result['parameter']} {result['at']:g}", result))
-    return out
+def read_kept(parser: argparse.ArgumentParser, path: pathlib.Path) -> dict:
+    """The kept profile trial file ``path``, or a one-line parser error: not JSON, not a kept profile run, or not
+    complete (a stopped run)."""
+    try:
+        kept = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, ValueError) as error:
+        parser.error(f"{path}: cannot read it as JSON ({error.__class__.__name__})")
+    if not isinstance(kept, dict) or not isinstance(kept.get("results"), list) or not all(
+            isinstance(r, dict) and {"parameter", "at", "cost", "under_cut", "values", "t3"} <= set(r)
+            for r in kept["results"]):
+        parser.error(f"{path}: not a kept profile trial file (no results as the trial writes them)")
+    if kept.get("complete") is not True:
+        parser.error(f"{path}: a stopped profile run (not complete): run it whole first")
+    return kept
 
 
-def main() -> None:
+def smc_ahead(result: dict) -> int:
+    """How many of the six T3 payload and orientation cells sliding mode leads in, from a kept result's cells
+    (matched to :data:`PREDICTION_CELLS` by controller, payload and orientation)."""
+    mean = {(t["controller"], t["payload_g"], t["orientation"]): t["twin_mean"] for t in result["t3"]}
     rows = [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
+    return lead_counts(rows, [mean[(r["controller"], r["payload_g"], r["orientation"])] for r in rows])[0].get(
+        "smc", 0)
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("files", nargs="*", type=pathlib.Path, metavar="FILE",
+                        help="kept profile trial files (default: every one kept beside this script)")
+    parser.add_argument("--workers", type=int, default=2)
+    args = parser.parse_args(argv)
+    if args.workers < 1:
+        parser.error(f"--workers {args.workers}: give 1 or more")
+    paths = args.files or sorted(KEPT.glob("*.json"))
+    kept = [(path, read_kept(parser, path)) for path in paths]
     keys = [k for k in calibrate.CELLS if k in calibrate.EXPERIMENT_CELLS]
-    with calibrate.Evaluator(seeds=SEEDS, workers=2) as evaluator:
-        measured = None
-        for label, result in under_cut_refits():
-            cells = evaluator.cells(result["values"], keys=keys)
-            if measured is None:
-                measured = _order([{"controller": c.controller, "trajectory": c.trajectory,
-                                    "measured": calibrate.TARGET_OF[c.key].rmse_deg} for c in cells], "measured")
-                print("measured order: " + "; ".join(f"T{t} {order}" for t, order in measured.items()))
-            twin = _known_orders(cells)
-            right = [t for t in measured if twin.get(t) == measured[t]]
-            wrong = "; ".join(f"T{t} {twin[t]}" for t in measured if t not in right)
-            ahead = lead_counts(rows, [c["twin_mean"] for c in result["t3"]])[0].get("smc", 0)
-            print(f"{label}: cost {result['cost']:.4f}; Chapter 5 order right on {len(right)} of {len(measured)}"
-                  + (f" (wrong: {wrong})" if wrong else "") + f"; sliding mode ahead in {ahead} of 6 T3 cells",
+    measured = controller_order([{"controller": k[0], "trajectory": k[1],
+                                  "measured": calibrate.TARGET_OF[k].rmse_deg} for k in keys], "measured")
+    print("measured order: " + "; ".join(f"T{t} {order}" for t, order in measured.items()))
+    with calibrate.Evaluator(seeds=SEEDS, workers=args.workers) as evaluator:
+        for path, file in kept:
+            under = [r for r in file["results"] if r["under_cut"]]
+            print(f"{path.name} (preset {file.get('preset')}): {len(under)} of {len(file['results'])} under the cut",
                   flush=True)
+            for result in under:
+                twin = known_orders(evaluator.cells(result["values"], keys=keys))
+                right = [t for t in measured if twin.get(t) == measured[t]]
+                wrong = "; ".join(f"T{t} {twin[t]}" for t in measured if t not in right)
+                print(f"  {result['parameter']} {result['at']:g}: cost {result['cost']:.4f}; Chapter 5 order right on "
+                      f"{len(right)} of {len(measured)}" + (f" (wrong: {wrong})" if wrong else "")
+                      + f"; sliding mode ahead in {smc_ahead(result)} of 6 T3 cells", flush=True)
 
 
 if __name__ == "__main__":

@@ -40,7 +40,7 @@ from controllers.ffpva import FeedForwardPVAGains, compensate, ffpva_duty
 from controllers.pva import PVAGains
 from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_PAYLOADS_G, THESIS_ROBUSTNESS_T1_DEG
-from twin.experiments.validate import PREDICTION_CELLS, _order, rmse_within
+from twin.experiments.validate import PREDICTION_CELLS, controller_order, rmse_within
 from twin.physics.model import Orientation
 from twin.plants.as_built import NINTH_REFIT_FILE, TENTH_REFIT_FILE, as_built_plant, calibrated_values, preset_digest
 from twin.sim.scenario import Scenario
@@ -120,7 +120,7 @@ def _orders_right(twin: dict) -> int:
     rows = [{"controller": law, "trajectory": t, "measured": THESIS_EXPERIMENT_RMSE_DEG[law][t][0],
              "twin_mean": twin[law, t, 0.0, "horizontal"]} for law in THESIS_EXPERIMENT_RMSE_DEG
             for t in THESIS_EXPERIMENT_RMSE_DEG[law]]
-    measured, ranked = _order(rows, "measured"), _order(rows, "twin_mean")
+    measured, ranked = controller_order(rows, "measured"), controller_order(rows, "twin_mean")
     return sum(measured[t] == ranked[t] for t in measured)
 
 

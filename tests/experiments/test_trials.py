@@ -1261,14 +1261,16 @@ def test_the_stop_47_profile_files_are_what_their_text_and_the_docs_quote(name):
     printed costs and 13.5 g vertical T3 cells those of the results."""
     import json
 
-    from twin.plants.as_built import CALIBRATION_FILE, calibration_cost_line, preset_digest
+    from twin.experiments.validate import lead_counts
 
     at, under, vertical = STOP_47_PROFILES[name]
     folder = ROOT / "examples" / "trial_profile_likelihood"
     kept = json.loads((folder / f"{name}.json").read_text())
     printed = (folder / f"{name}.txt").read_text()
-    assert kept["preset"] == preset_digest(CALIBRATION_FILE) == "13aadbb61885"
-    assert kept["cut"] == sum(calibration_cost_line(CALIBRATION_FILE))
+    # The thirteenth refit (committed at stop 46): its digest, and its cut (the twelfth's best and noise, as kept in
+    # the load-friction file), not the committed file's as it may be later.
+    assert kept["preset"] == "13aadbb61885"
+    assert kept["cut"] == json.loads((folder / "load_friction.json").read_text())["cut"] == 0.6468583228172117
     assert kept["complete"] and len(kept["evaluations"]) == 24 * len(at)
     assert [r["parameter"] for r in kept["results"]] == [name] * len(at)
     assert [r["at"] for r in kept["results"]] == at
@@ -1284,6 +1286,15 @@ def test_the_stop_47_profile_files_are_what_their_text_and_the_docs_quote(name):
     means = [[t["twin_mean"] for t in r["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]
              for r in kept["results"]]
     assert [f"{a:.2f} / {b:.2f}" for a, b in means] == vertical
+    # The rest of what each value prints: the cells within 20 %, all twelve T3 cells, the lead.
+    within = [int(n) for n in re.findall(r"^  cost .*; (\d+) of 21 measured RMSE cells within 20 %", printed, re.M)]
+    assert within == [r["measured_rmse_cells_within"] for r in kept["results"]]
+    cells = re.findall(r"^    T3 (\w+) +([\d.]+) g (\w+) +(\d+\.\d\d) ", printed, re.M)
+    assert cells == [(t["controller"], f"{t['payload_g']:g}", t["orientation"], f"{t['twin_mean']:.2f}")
+                     for r in kept["results"] for t in r["t3"]]
+    rows = [{k: t[k] for k in ("controller", "payload_g", "orientation")} for t in kept["results"][0]["t3"]]
+    ahead = [int(n) for n in re.findall(r"^    sliding mode ahead in (\d) of 6 T3 cells", printed, re.M)]
+    assert ahead == [lead_counts(rows, [t["twin_mean"] for t in r["t3"]])[0].get("smc", 0) for r in kept["results"]]
 
 
 @pytest.mark.slow  # about 1 min on 2 cores each: four parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
@@ -1302,20 +1313,44 @@ def test_the_stop_47_profiles_kept_results_run_again_to_the_last_bit(capsys, nam
     assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
 
 
-@pytest.mark.slow  # about 20 s on 2 cores: nine parameter sets on the eleven Chapter 5 cells x 5 seeds
+@pytest.mark.slow  # about 20 s on 2 cores: nine parameter sets on the eleven Chapter 5 cells x 5 seeds, five kept files
 def test_the_profile_orders_trial_prints_what_it_kept(capsys):
-    _load("trial_profile_orders").main()
+    _load("trial_profile_orders").main([])
     kept = (ROOT / "examples" / "trial_profile_likelihood" / "orders.txt").read_text()
     assert capsys.readouterr().out == kept
+
+
+@pytest.mark.parametrize(("text", "said"), [
+    (None, "cannot read it as JSON (FileNotFoundError)"),
+    ("{", "cannot read it as JSON (JSONDecodeError)"),
+    ("[]", "not a kept profile trial file"),
+    ('{"results": [{"at": 1}], "complete": true}', "not a kept profile trial file"),
+    ('{"results": [], "complete": false}', "a stopped profile run (not complete)"),
+])
+def test_the_profile_orders_trial_refuses_a_file_it_cannot_use_before_it_runs(capsys, monkeypatch, tmp_path, text,
+                                                                            said):
+    from twin.experiments import calibrate
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the trial started its runs")
+
+    monkeypatch.setattr(calibrate, "Evaluator", no_run)
+    path = tmp_path / "kept.json"
+    if text is not None:
+        path.write_text(text)
+    with pytest.raises(SystemExit) as stop:
+        _load("trial_profile_orders").main([str(path)])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and f"{path}: {said}" in err and "Traceback" not in err
 
 
 def test_the_profile_orders_kept_text_pairs_each_reversed_t3_lead_with_a_wrong_chapter_5_order():
     """What docs/investigations.md reads from orders.txt: every refit under the cut with the measured Chapter 5
     order on all four trajectories has sliding mode ahead in all six T3 cells, and every one with FF + PVA ahead in
     a T3 cell gets one or more trajectories' order wrong; nine refits, five with the order right on all four."""
-    lines = (ROOT / "examples" / "trial_profile_likelihood" / "orders.txt").read_text().splitlines()[1:]
+    lines = (ROOT / "examples" / "trial_profile_likelihood" / "orders.txt").read_text().splitlines()
     found = [(int(a), int(b)) for a, b in (re.search(r"order right on (\d) of 4.*ahead in (\d) of 6", line).groups()
-                                           for line in lines)]
+                                           for line in lines if line.startswith("  "))]
     assert len(found) == 9 and sum(right == 4 for right, _ in found) == 5
     assert all(ahead == 6 for right, ahead in found if right == 4)
     assert sorted(ahead for right, ahead in found if ahead < 6) == [0, 2, 3]

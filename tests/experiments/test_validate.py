@@ -1161,7 +1161,7 @@ def test_a_member_without_a_mean_is_not_counted_out_or_in():
 
     cells = [CellResult(c, t, (x,) * 5, (0.0,) * 5, seeds=tuple(range(5)))
              for c, t, x in (("ffpva", 1, 1.2), ("smc", 1, 1.1), ("ffpva", 2, math.nan), ("smc", 2, 1.5))]
-    assert validate._known_orders(cells) == {1: "sliding mode < FF + PVA", 2: None}
+    assert validate.known_orders(cells) == {1: "sliding mode < FF + PVA", 2: None}
     v = _fake(1.0, lag_within=True, stalled=0)
     pva2 = ("pva", 2, 0.0, "horizontal")  # committed x0.75, out
     v.prediction_detail["fitted_means"] = [{pva2: math.nan}, {pva2: 2.2}]

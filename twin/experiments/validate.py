@@ -768,7 +768,7 @@ def prediction(evaluator: calibrate.Evaluator, committed: dict[str, float], prog
     detail = {"members": members, "runs": len(members) * len(SEEDS), "costs": costs, "cost_line": calibration_cost_line(),
               "committed": next((k for k, values in enumerate(members) if values == committed), None),
               "per_member": [[c.mean_rmse for c in m] for m in per_member],
-              "orders": [_known_orders(m) for m in experiment],
+              "orders": [known_orders(m) for m in experiment],
               "fitted_means": [{c.key: c.mean_rmse for c in m} for m in fitted]}
     return rows, own, detail
 
@@ -840,11 +840,11 @@ def _members_within_text(detail: dict, r: dict) -> str:
     return f"; within on {within} of the ensemble's {len(ran)} members (seeds 0-4{span})"
 
 
-def _known_orders(cells: Sequence[calibrate.CellResult]) -> dict[int, str | None]:
+def known_orders(cells: Sequence[calibrate.CellResult]) -> dict[int, str | None]:
     """Per trajectory of ``cells`` (one member's Chapter 5 cells) the controllers' order, best first; None
     where a cell's runs give no mean (a failed run): its order is not known."""
     rows = [{"controller": c.controller, "trajectory": c.trajectory, "twin_mean": c.mean_rmse} for c in cells]
-    known = _order([r for r in rows if math.isfinite(r["twin_mean"])], "twin_mean")
+    known = controller_order([r for r in rows if math.isfinite(r["twin_mean"])], "twin_mean")
     return {t: (known.get(t) if all(math.isfinite(r["twin_mean"]) for r in rows if r["trajectory"] == t) else None)
             for t in sorted({r["trajectory"] for r in rows})}
 
@@ -1020,7 +1020,7 @@ def _fmt(value, spec=".2f") -> str:
     return "–" if value is None or (isinstance(value, float) and math.isnan(value)) else format(value, spec)
 
 
-def _order(rows: Sequence[dict], value: str) -> dict[int, str]:
+def controller_order(rows: Sequence[dict], value: str) -> dict[int, str]:
     """Per trajectory, the controllers from best to worst by ``value`` ("measured" or "twin_mean")."""
     out: dict[int, str] = {}
     for t in sorted({r["trajectory"] for r in rows}):
@@ -1121,7 +1121,7 @@ def _why_seeds(v: Validation) -> list[str]:
                              f"{r['runs']} runs x{r['ratio']:.2f}, {r['groups_within']} of {r['groups']} groups within)"
                              for r in split) + ".")
     flat = [r for r in rows if r["payload_g"] == 0.0 and r["orientation"] == "horizontal"]
-    measured, twin = _order(flat, "measured"), _order(flat, "twin_mean")
+    measured, twin = controller_order(flat, "measured"), controller_order(flat, "twin_mean")
     if measured:
         same = [t for t in measured if measured[t] == twin[t]]
         line += (f" Controller order on the {runs}-run means (Chapter 5): right on {len(same)} of {len(measured)} "
@@ -1387,10 +1387,10 @@ def misses(v: Validation) -> list[dict]:
                 None if r["twin_mean"] is None else r["twin_mean"] - r["measured"], f and f["sse_twin"],
                 f and f["sse_within_tolerance"], f and f["sse_groups_within"], *_sse_reading(r, f, v))
     finite = [r for r in experiment if r["twin_mean"] is not None and math.isfinite(r["twin_mean"])]
-    rig, twin = _order(finite, "measured"), _order(finite, "twin_mean")
+    rig, twin = controller_order(finite, "measured"), controller_order(finite, "twin_mean")
     fresh_flat = [r for r in v.seeds or [] if r["payload_g"] == 0.0 and r["orientation"] == "horizontal"
                   and math.isfinite(r["twin_mean"])]
-    fresh_order = _order(fresh_flat, "twin_mean")
+    fresh_order = controller_order(fresh_flat, "twin_mean")
     for t in rig:
         ran = {r["controller"] for r in fresh_flat if r["trajectory"] == t}
         complete = t in fresh_order and ran == {r["controller"] for r in finite if r["trajectory"] == t}
@@ -1400,7 +1400,7 @@ def misses(v: Validation) -> list[dict]:
         on = [r for r in (finite if rig[t] != twin[t] else fresh_flat) if r["trajectory"] == t]
         out_cells = [r for r in on if not r["within_tolerance"]]
         pairs = _swapped_pairs(on)
-        restored = _order([dict(r, twin_mean=r["measured"] if r in out_cells else r["twin_mean"]) for r in on],
+        restored = controller_order([dict(r, twin_mean=r["measured"] if r in out_cells else r["twin_mean"]) for r in on],
                           "twin_mean").get(t)
         if rig[t] != twin[t] and right:
             reading, text = "draw", f"right on the {fresh_flat[0]['runs']}-run means"
@@ -1538,7 +1538,7 @@ def _why(v: Validation) -> list[str]:
     rows = v.rows
     lines = []
     experiment = [r for r in rows if r["source"] == "chapter 5 experiment"]
-    measured, twin = _order(experiment, "measured"), _order(experiment, "twin_mean")
+    measured, twin = controller_order(experiment, "measured"), controller_order(experiment, "twin_mean")
     same = [t for t in measured if measured[t] == twin[t]]
     lines.append(f"- **Controller order** (Chapter 5 experiments, best first): right on "
                  f"{len(same)} of {len(measured)} trajectories. "
@@ -2038,7 +2038,7 @@ def _member_facts(v: Validation) -> tuple[list[int], dict[int, list[int]], list[
     (:func:`member_cells_within`), per Chapter 5 trajectory the members whose order is right
     (:func:`member_orders`; {} without the experiments' rows) and its T3 leads (:func:`member_leads`)."""
     experiment = [r for r in v.rows if r["source"] == "chapter 5 experiment"]
-    orders = member_orders(v.prediction_detail, _order(experiment, "measured")) if experiment else {}
+    orders = member_orders(v.prediction_detail, controller_order(experiment, "measured")) if experiment else {}
     return member_cells_within(v), orders, member_leads(v.prediction, v.prediction_detail)
 
 
