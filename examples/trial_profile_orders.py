@@ -25,19 +25,26 @@ import pathlib
 
 from twin.experiments import calibrate
 from twin.experiments.validate import PREDICTION_CELLS, SEEDS, controller_order, known_orders, lead_counts
+from twin.plants.as_built import FITTED
 
 KEPT = pathlib.Path(__file__).resolve().parent / "trial_profile_likelihood"
 
 
 def read_kept(parser: argparse.ArgumentParser, path: pathlib.Path) -> dict:
-    """The kept profile trial file ``path``, or a one-line parser error: not JSON, not a kept profile run, or not
-    complete (a stopped run)."""
+    """The kept profile trial file ``path``, or a one-line parser error: not JSON, not a kept profile run (each
+    result with the fitted parameters' values and the twelve T3 cells), or not complete (a stopped run)."""
     try:
         kept = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, ValueError) as error:
         parser.error(f"{path}: cannot read it as JSON ({error.__class__.__name__})")
+    cells = sorted((c, g, o) for c, _, g, o in PREDICTION_CELLS)
+    names = {f.name for f in FITTED}
     if not isinstance(kept, dict) or not isinstance(kept.get("results"), list) or not all(
             isinstance(r, dict) and {"parameter", "at", "cost", "under_cut", "values", "t3"} <= set(r)
+            and isinstance(r["values"], dict) and set(r["values"]) == names and isinstance(r["t3"], list)
+            and all(isinstance(t, dict) and {"controller", "payload_g", "orientation", "twin_mean"} <= set(t)
+                    for t in r["t3"])
+            and sorted((t["controller"], t["payload_g"], t["orientation"]) for t in r["t3"]) == cells
             for r in kept["results"]):
         parser.error(f"{path}: not a kept profile trial file (no results as the trial writes them)")
     if kept.get("complete") is not True:

@@ -1256,9 +1256,9 @@ STOP_47_PROFILES = {
 
 @pytest.mark.parametrize("name", list(STOP_47_PROFILES))
 def test_the_stop_47_profile_files_are_what_their_text_and_the_docs_quote(name):
-    """The breakaway, leak, free-air and observer-gain profiles: run on the thirteenth refit's preset (the committed one: its digest
-    and its cut), complete, the values in the order run, each result the lowest of its own 24 evaluations, and the
-    printed costs and 13.5 g vertical T3 cells those of the results."""
+    """The breakaway, leak, free-air and observer-gain profiles: run on the thirteenth refit's preset (its digest and
+    its cut), complete, the values in the order run, each result the lowest of its own 24 evaluations, and the printed
+    costs, cells within 20 %, twelve T3 cells and leads those of the results."""
     import json
 
     from twin.experiments.validate import lead_counts
@@ -1292,9 +1292,21 @@ def test_the_stop_47_profile_files_are_what_their_text_and_the_docs_quote(name):
     cells = re.findall(r"^    T3 (\w+) +([\d.]+) g (\w+) +(\d+\.\d\d) ", printed, re.M)
     assert cells == [(t["controller"], f"{t['payload_g']:g}", t["orientation"], f"{t['twin_mean']:.2f}")
                      for r in kept["results"] for t in r["t3"]]
-    rows = [{k: t[k] for k in ("controller", "payload_g", "orientation")} for t in kept["results"][0]["t3"]]
     ahead = [int(n) for n in re.findall(r"^    sliding mode ahead in (\d) of 6 T3 cells", printed, re.M)]
-    assert ahead == [lead_counts(rows, [t["twin_mean"] for t in r["t3"]])[0].get("smc", 0) for r in kept["results"]]
+    assert ahead == [lead_counts([{k: t[k] for k in ("controller", "payload_g", "orientation")} for t in r["t3"]],
+                                 [t["twin_mean"] for t in r["t3"]])[0].get("smc", 0) for r in kept["results"]]
+
+
+def test_the_profile_trial_names_its_calibration_from_the_checkouts_root(tmp_path):
+    """A kept file names a calibration inside the checkout from its root (not the absolute path of the machine it ran
+    on), and one outside it as given."""
+    from twin.plants.as_built import CALIBRATION_FILE, TWELFTH_REFIT_FILE
+
+    trial = _load("trial_profile_likelihood")
+    assert trial.shown(CALIBRATION_FILE) == "twin/plants/data/as_built.json"
+    assert trial.shown(ROOT / "twin" / "plants" / "data" / ".." / "data" / "twelfth_refit.json") == (
+        "twin/plants/data/twelfth_refit.json") == trial.shown(TWELFTH_REFIT_FILE)
+    assert trial.shown(tmp_path / "mine.json") == str(tmp_path / "mine.json")
 
 
 @pytest.mark.slow  # about 1 min on 2 cores each: four parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
@@ -1326,6 +1338,8 @@ def test_the_profile_orders_trial_prints_what_it_kept(capsys):
     ("[]", "not a kept profile trial file"),
     ('{"results": [{"at": 1}], "complete": true}', "not a kept profile trial file"),
     ('{"results": [], "complete": false}', "a stopped profile run (not complete)"),
+    ('{"results": [{"parameter": "air_fraction", "at": 0.02, "cost": 0.6, "under_cut": true, "values": {}, "t3": []}],'
+     ' "complete": true}', "not a kept profile trial file"),
 ])
 def test_the_profile_orders_trial_refuses_a_file_it_cannot_use_before_it_runs(capsys, monkeypatch, tmp_path, text,
                                                                             said):

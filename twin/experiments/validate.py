@@ -1400,8 +1400,8 @@ def misses(v: Validation) -> list[dict]:
         on = [r for r in (finite if rig[t] != twin[t] else fresh_flat) if r["trajectory"] == t]
         out_cells = [r for r in on if not r["within_tolerance"]]
         pairs = _swapped_pairs(on)
-        restored = controller_order([dict(r, twin_mean=r["measured"] if r in out_cells else r["twin_mean"]) for r in on],
-                          "twin_mean").get(t)
+        restored = controller_order(
+            [dict(r, twin_mean=r["measured"] if r in out_cells else r["twin_mean"]) for r in on], "twin_mean").get(t)
         if rig[t] != twin[t] and right:
             reading, text = "draw", f"right on the {fresh_flat[0]['runs']}-run means"
         elif out_cells and restored == rig[t]:
