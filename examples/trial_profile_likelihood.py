@@ -29,8 +29,8 @@ further starts of ``twin calibrate`` since file version 11 (``twin/plants/data/p
 refit, the committed one (digest 13aadbb61885), each file beside the first: ``stiction``, ``leak_conductance``,
 ``air_fraction`` and ``observer_gain``. The first three were given ``--calibration twin/plants/data/as_built.json``,
 the file the default reads; the fourth ran on the default. Its file and ``load_friction.json`` name the calibration
-by the absolute path of the checkout they ran in (kept files name it from the checkout's root since). Every result is recorded in
-docs/investigations.md.
+by the absolute path of the checkout they ran in (kept files name it from the checkout's root since). Every result
+is recorded in docs/investigations.md.
 
     python examples/trial_profile_likelihood.py --parameter load_friction --at 0.40 0.45 0.50 0.10 0.05 \
         --calibration twin/plants/data/twelfth_refit.json --out FILE

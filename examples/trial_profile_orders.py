@@ -30,22 +30,29 @@ from twin.plants.as_built import FITTED
 KEPT = pathlib.Path(__file__).resolve().parent / "trial_profile_likelihood"
 
 
+CELLS = sorted((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # the T3 cells a kept result holds, by key
+
+
+def is_result(r) -> bool:
+    """Whether ``r`` is a result as the profile trial keeps it: its value, cost and cut, the fitted parameters' values
+    and the twelve T3 cells."""
+    return (isinstance(r, dict) and {"parameter", "at", "cost", "under_cut", "values", "t3"} <= set(r)
+            and isinstance(r["values"], dict) and set(r["values"]) == {f.name for f in FITTED}
+            and isinstance(r["t3"], list)
+            and all(isinstance(t, dict) and {"controller", "payload_g", "orientation", "twin_mean"} <= set(t)
+                    for t in r["t3"])
+            and sorted((t["controller"], t["payload_g"], t["orientation"]) for t in r["t3"]) == CELLS)
+
+
 def read_kept(parser: argparse.ArgumentParser, path: pathlib.Path) -> dict:
-    """The kept profile trial file ``path``, or a one-line parser error: not JSON, not a kept profile run (each
-    result with the fitted parameters' values and the twelve T3 cells), or not complete (a stopped run)."""
+    """The kept profile trial file ``path``, or a one-line parser error: not JSON, not a kept profile run
+    (:func:`is_result`), or not complete (a stopped run)."""
     try:
         kept = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, ValueError) as error:
         parser.error(f"{path}: cannot read it as JSON ({error.__class__.__name__})")
-    cells = sorted((c, g, o) for c, _, g, o in PREDICTION_CELLS)
-    names = {f.name for f in FITTED}
     if not isinstance(kept, dict) or not isinstance(kept.get("results"), list) or not all(
-            isinstance(r, dict) and {"parameter", "at", "cost", "under_cut", "values", "t3"} <= set(r)
-            and isinstance(r["values"], dict) and set(r["values"]) == names and isinstance(r["t3"], list)
-            and all(isinstance(t, dict) and {"controller", "payload_g", "orientation", "twin_mean"} <= set(t)
-                    for t in r["t3"])
-            and sorted((t["controller"], t["payload_g"], t["orientation"]) for t in r["t3"]) == cells
-            for r in kept["results"]):
+            is_result(r) for r in kept["results"]):
         parser.error(f"{path}: not a kept profile trial file (no results as the trial writes them)")
     if kept.get("complete") is not True:
         parser.error(f"{path}: a stopped profile run (not complete): run it whole first")

@@ -1194,89 +1194,46 @@ def test_the_profile_trials_check_exits_1_when_a_kept_number_is_not_run_again(ca
     assert lines[2].endswith("as kept: False; T3 cells as kept: True")
 
 
-def test_the_profile_trials_kept_file_is_what_its_text_and_the_docs_quote():
-    """The kept load-friction profile: run on the twelfth refit's preset (its digest and its cut), complete, its five
-    values in the order run, and the printed costs and 13.5 g vertical T3 cells those of its results, which
-    docs/investigations.md quotes."""
-    import json
-
-    from twin.plants.as_built import TWELFTH_REFIT_FILE, calibration_cost_line, preset_digest
-
-    folder = ROOT / "examples" / "trial_profile_likelihood"
-    kept = json.loads((folder / "load_friction.json").read_text())
-    printed = (folder / "load_friction.txt").read_text()
-    assert kept["preset"] == preset_digest(TWELFTH_REFIT_FILE) == "6bb9e9258023"
-    assert kept["cut"] == sum(calibration_cost_line(TWELFTH_REFIT_FILE))
-    assert kept["complete"] and len(kept["evaluations"]) == 120
-    assert [r["at"] for r in kept["results"]] == [0.40, 0.45, 0.50, 0.10, 0.05]
-    costs = [float(c) for c in re.findall(r"^  cost (\d\.\d+) \(", printed, re.M)]
-    assert costs == [round(r["cost"], 4) for r in kept["results"]]
-    shown = re.findall(r"^    T3 (\w+) +13\.5 g vertical +(\d\.\d\d) ", printed, re.M)
-    assert [f"{a[1]} / {b[1]}" for a, b in zip(shown[::2], shown[1::2], strict=True)] == [
-        "4.28 / 4.09", "4.87 / 4.50", "5.51 / 4.90", "3.11 / 2.79", "3.09 / 2.75"]
-    assert [r["under_cut"] for r in kept["results"]] == [True, True, False, False, True]
-    assert all(r["under_cut"] == (r["cost"] <= kept["cut"]) for r in kept["results"])
-    for r in kept["results"]:  # each value's result is the lowest of its own evaluations
-        own = [e["cost"] for e in kept["evaluations"] if e["at"] == r["at"]]
-        assert len(own) == 24 and r["cost"] == min(own)
-    vertical = [[t["twin_mean"] for t in r["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]
-                for r in kept["results"]]
-    assert [f"{a:.2f} / {b:.2f}" for a, b in vertical] == [
-        "4.28 / 4.09", "4.87 / 4.50", "5.51 / 4.90", "3.11 / 2.79", "3.09 / 2.75"]
-
-
-@pytest.mark.slow  # about 1 min on 2 cores: five parameter sets on the fit's 21 cells x 10 seeds and T3's 12 x 5
-def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys):
-    try:  # exit 1 on a mismatch: the lines below then say which
-        _load("trial_profile_likelihood").main(["--check", str(ROOT / "examples" / "trial_profile_likelihood" /
-                                                                  "load_friction.json")])
-        code = 0
-    except SystemExit as stop:
-        code = stop.code
-    lines = capsys.readouterr().out.splitlines()
-    assert code == 0, lines
-    assert lines[0].endswith("preset 6bb9e9258023, 5 values of load_friction")
-    assert [line.split(":")[0].strip() for line in lines[1:]] == ["0.4", "0.45", "0.5", "0.1", "0.05"]
-    assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
-
-
-# The stop-47 profiles, on the thirteenth refit: each file's values in the order run, which were under the cut, and
-# the 13.5 g vertical T3 cells (FF + PVA / sliding mode) as printed and as docs/investigations.md quotes them.
-STOP_47_PROFILES = {
-    "stiction": ([2.1, 2.35, 2.55, 1.0], [False, False, False, True],
+# Each kept profile: its preset, its values in the order run, which were under the cut, and the 13.5 g vertical T3
+# cells (FF + PVA / sliding mode) as printed and as docs/investigations.md quotes them. The load friction ran on the
+# twelfth refit (stop 46), the others on the thirteenth (stop 47); the two have the same cut.
+PROFILES = {
+    "load_friction": ("6bb9e9258023", [0.40, 0.45, 0.50, 0.10, 0.05], [True, True, False, False, True],
+                      ["4.28 / 4.09", "4.87 / 4.50", "5.51 / 4.90", "3.11 / 2.79", "3.09 / 2.75"]),
+    "stiction": ("13aadbb61885", [2.1, 2.35, 2.55, 1.0], [False, False, False, True],
                  ["11.06 / 8.34", "16.14 / 13.34", "26.65 / 26.61", "3.61 / 3.42"]),
-    "leak_conductance": ([1e-14, 5e-15, 0.0, 3e-14], [True, True, False, True],
+    "leak_conductance": ("13aadbb61885", [1e-14, 5e-15, 0.0, 3e-14], [True, True, False, True],
                          ["3.36 / 3.38", "3.59 / 3.38", "3.70 / 3.50", "4.16 / 3.81"]),
-    "air_fraction": ([0.02, 0.01, 0.065, 0.08], [True, False, True, False],
+    "air_fraction": ("13aadbb61885", [0.02, 0.01, 0.065, 0.08], [True, False, True, False],
                      ["3.78 / 3.94", "4.97 / 4.84", "3.91 / 3.56", "4.26 / 3.68"]),
-    "observer_gain": ([250.0, 150.0, 700.0, 900.0], [False, False, False, False],
+    "observer_gain": ("13aadbb61885", [250.0, 150.0, 700.0, 900.0], [False, False, False, False],
                       ["3.56 / 3.49", "3.31 / 3.32", "4.21 / 3.95", "4.34 / 3.92"]),
 }
 
 
-@pytest.mark.parametrize("name", list(STOP_47_PROFILES))
-def test_the_stop_47_profile_files_are_what_their_text_and_the_docs_quote(name):
-    """The breakaway, leak, free-air and observer-gain profiles: run on the thirteenth refit's preset (its digest and
-    its cut), complete, the values in the order run, each result the lowest of its own 24 evaluations, and the printed
-    costs, cells within 20 %, twelve T3 cells and leads those of the results."""
+@pytest.mark.parametrize("name", list(PROFILES))
+def test_the_profile_trials_kept_files_are_what_their_text_and_the_docs_quote(name):
+    """Each kept profile: run on its preset (its digest and the cut of the twelfth and thirteenth refits), complete,
+    the values in the order run, each result the lowest of its own 24 evaluations, and the printed costs, cells within
+    20 %, twelve T3 cells and leads those of the results, which docs/investigations.md quotes."""
     import json
 
     from twin.experiments.validate import lead_counts
+    from twin.plants.as_built import TWELFTH_REFIT_FILE, calibration_cost_line, preset_digest
 
-    at, under, vertical = STOP_47_PROFILES[name]
+    preset, at, under, vertical = PROFILES[name]
     folder = ROOT / "examples" / "trial_profile_likelihood"
     kept = json.loads((folder / f"{name}.json").read_text())
     printed = (folder / f"{name}.txt").read_text()
-    # The thirteenth refit (committed at stop 46): its digest, and its cut (the twelfth's best and noise, as kept in
-    # the load-friction file), not the committed file's as it may be later.
-    assert kept["preset"] == "13aadbb61885"
-    assert kept["cut"] == json.loads((folder / "load_friction.json").read_text())["cut"] == 0.6468583228172117
+    assert kept["preset"] == preset
+    assert preset_digest(TWELFTH_REFIT_FILE) == "6bb9e9258023"
+    assert kept["cut"] == sum(calibration_cost_line(TWELFTH_REFIT_FILE)) == 0.6468583228172117
     assert kept["complete"] and len(kept["evaluations"]) == 24 * len(at)
     assert [r["parameter"] for r in kept["results"]] == [name] * len(at)
     assert [r["at"] for r in kept["results"]] == at
     assert [r["under_cut"] for r in kept["results"]] == under
     assert all(r["under_cut"] == (r["cost"] <= kept["cut"]) for r in kept["results"])
-    for r in kept["results"]:
+    for r in kept["results"]:  # each value's result is the lowest of its own evaluations
         own = [e["cost"] for e in kept["evaluations"] if e["at"] == r["at"]]
         assert len(own) == 24 and r["cost"] == min(own) and r["values"][name] == r["at"]
     costs = [float(c) for c in re.findall(r"^  cost (\d\.\d+) \(", printed, re.M)]
@@ -1297,6 +1254,23 @@ def test_the_stop_47_profile_files_are_what_their_text_and_the_docs_quote(name):
                                  [t["twin_mean"] for t in r["t3"]])[0].get("smc", 0) for r in kept["results"]]
 
 
+@pytest.mark.slow  # about 30 s on 2 cores each: four or five parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
+@pytest.mark.parametrize("name", list(PROFILES))
+def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys, name):
+    try:  # exit 1 on a mismatch: the lines below then say which
+        _load("trial_profile_likelihood").main(["--check", str(ROOT / "examples" / "trial_profile_likelihood" /
+                                                                  f"{name}.json")])
+        code = 0
+    except SystemExit as stop:
+        code = stop.code
+    lines = capsys.readouterr().out.splitlines()
+    preset, at, _, _ = PROFILES[name]
+    assert code == 0, lines
+    assert lines[0].endswith(f"preset {preset}, {len(at)} values of {name}")
+    assert [float(line.split(":")[0]) for line in lines[1:]] == at
+    assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
+
+
 def test_the_profile_trial_names_its_calibration_from_the_checkouts_root(tmp_path):
     """A kept file names a calibration inside the checkout from its root (not the absolute path of the machine it ran
     on), and one outside it as given."""
@@ -1307,22 +1281,6 @@ def test_the_profile_trial_names_its_calibration_from_the_checkouts_root(tmp_pat
     assert trial.shown(ROOT / "twin" / "plants" / "data" / ".." / "data" / "twelfth_refit.json") == (
         "twin/plants/data/twelfth_refit.json") == trial.shown(TWELFTH_REFIT_FILE)
     assert trial.shown(tmp_path / "mine.json") == str(tmp_path / "mine.json")
-
-
-@pytest.mark.slow  # about 1 min on 2 cores each: four parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
-@pytest.mark.parametrize("name", list(STOP_47_PROFILES))
-def test_the_stop_47_profiles_kept_results_run_again_to_the_last_bit(capsys, name):
-    try:  # exit 1 on a mismatch: the lines below then say which
-        _load("trial_profile_likelihood").main(["--check", str(ROOT / "examples" / "trial_profile_likelihood" /
-                                                                  f"{name}.json")])
-        code = 0
-    except SystemExit as stop:
-        code = stop.code
-    lines = capsys.readouterr().out.splitlines()
-    assert code == 0, lines
-    assert lines[0].endswith(f"preset 13aadbb61885, 4 values of {name}")
-    assert [float(line.split(":")[0]) for line in lines[1:]] == STOP_47_PROFILES[name][0]
-    assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
 
 
 @pytest.mark.slow  # about 20 s on 2 cores: nine parameter sets on the eleven Chapter 5 cells x 5 seeds, five kept files
