@@ -18,7 +18,10 @@ another; its preset digest is printed. Nothing is installed or refitted in the p
 seen. ``--out FILE`` keeps every evaluation and each point's result as JSON (written whole once the trial ends,
 refused if the file is there; on a stop, what ran is written before it stops). ``--check FILE`` runs a kept file's
 results again (each value's refitted set on the fit seeds, and its T3 cells) and prints whether they give the kept
-costs and cells, in about a minute; it exits 1 if any does not.
+costs and cells, in about a minute; it exits 1 if any does not. ``--start FILE AT`` starts the first value from
+the refit a kept trial file holds at AT instead of the nearest set (a longer search from where a kept one stopped, or
+another start); the later values start from the nearest set known, the kept start among them. The kept file records
+the start as its file and AT; that file names the preset it ran on.
 
 On 2026-11-28 (stop 46) it ran the load friction at 0.40, 0.45, 0.50, 0.10 and 0.05 N/N on the twelfth refit
 (``--calibration twin/plants/data/twelfth_refit.json``, digest 6bb9e9258023; 120 evaluations, 543 s on 2 cores):
@@ -30,7 +33,12 @@ refit, the committed one (digest 13aadbb61885), each file beside the first: ``st
 ``air_fraction`` and ``observer_gain``. The first three were given ``--calibration twin/plants/data/as_built.json``,
 the file the default reads; the fourth ran on the default. Its file and ``load_friction.json`` name the calibration
 by the absolute path of the checkout they ran in (kept files name it from the checkout's root since). Every result
-is recorded in docs/investigations.md.
+is recorded in docs/investigations.md. On 2026-11-29 (stop 48) it searched longer (``--evaluations 48``) on the
+thirteenth refit, each run from a kept refit (``--start``): the load friction at 0.50 (from its 0.50 refit), 0.55
+and 0.60, at 0.10 (from its 0.10 refit) and at 0 (from its 0.05 refit); the free air at 8 % and the observer gain at
+250 and at 700 1/s, each from its refit; and the breakaway at 2.10 N from the load friction's 0.05 N/N refit, a start
+with little load friction. 432 evaluations in 2048 s on 2 cores, alone; kept in
+``examples/trial_profile_likelihood/longer/``, each file named for its parameter and values.
 
     python examples/trial_profile_likelihood.py --parameter load_friction --at 0.40 0.45 0.50 0.10 0.05 \
         --calibration twin/plants/data/twelfth_refit.json --out FILE
@@ -38,6 +46,8 @@ is recorded in docs/investigations.md.
     python examples/trial_profile_likelihood.py --parameter leak_conductance --at 1e-14 5e-15 0 3e-14 --out FILE
     python examples/trial_profile_likelihood.py --parameter air_fraction --at 0.02 0.01 0.065 0.08 --out FILE
     python examples/trial_profile_likelihood.py --parameter observer_gain --at 250 150 700 900 --out FILE
+    python examples/trial_profile_likelihood.py --parameter load_friction --at 0.50 0.55 0.60 --evaluations 48 \
+        --start examples/trial_profile_likelihood/load_friction.json 0.50 --out FILE
     python examples/trial_profile_likelihood.py --check examples/trial_profile_likelihood/load_friction.json
 """
 
@@ -147,6 +157,31 @@ def check(kept: dict, path: pathlib.Path, workers: int) -> bool:
     return same
 
 
+def kept_start(parser: argparse.ArgumentParser, path: str, at: str) -> tuple[dict[str, float], float]:
+    """The refitted values and cost of the kept trial file ``path``'s result at ``at`` (``--start``), or a one-line
+    parser error."""
+    try:
+        value = float(at)
+    except ValueError:
+        parser.error(f"--start {path} {at}: AT must be a number")
+    kept = read_json(parser, pathlib.Path(path), "--start")
+    results = kept.get("results")
+    found = [r for r in results if isinstance(r, dict) and r.get("at") == value] if isinstance(results, list) else []
+    if not found:
+        parser.error(f"--start {path}: no kept result at {value:g}")
+    if len(found) > 1:
+        parser.error(f"--start {path}: {len(found)} kept results at {value:g}, so which to start from is not clear")
+    values, cost = found[0].get("values"), found[0].get("cost")
+    if not (isinstance(values, dict) and set(values) == {f.name for f in FITTED} and all(
+            isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v) for v in values.values())
+            and isinstance(cost, float) and math.isfinite(cost)):
+        parser.error(f"--start {path}: its result at {value:g} has not the fitted values and a finite cost")
+    for f in FITTED:  # a set outside the box would be clipped into it: its first evaluation would not be the kept set
+        if not f.low <= values[f.name] <= f.high:
+            parser.error(f"--start {path}: its result at {value:g} has {f.name} outside its box, {f.low:g}-{f.high:g}")
+    return {k: float(v) for k, v in values.items()}, cost
+
+
 def shown(path) -> str:
     """``path`` as a kept file names it: from the checkout's root when it lies in it, else as given."""
     try:
@@ -165,6 +200,8 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument("--calibration", type=pathlib.Path, default=None, help="the calibration file (default: the "
                         "committed one)")
     parser.add_argument("--evaluations", type=int, default=EVALUATIONS, help="refit budget per value")
+    parser.add_argument("--start", nargs=2, metavar=("FILE", "AT"), help="start the first value from a kept trial "
+                        "file's refit at AT (a longer search from where one stopped, or another start)")
     parser.add_argument("--out", type=pathlib.Path, metavar="FILE", help="keep the evaluations and results as JSON")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
@@ -173,6 +210,8 @@ def main(argv: list[str] | None = None) -> None:
     if args.check is not None:
         if args.out is not None:
             parser.error("--out keeps a profile run now (--at); --check writes nothing")
+        if args.start is not None:
+            parser.error("--start starts a profile run now (--at); --check runs the kept results as they are")
         kept = read_json(parser, args.check, "--check")
         results = kept.get("results")
         if not isinstance(results, list) or not results or "preset" not in kept or not all(
@@ -187,6 +226,7 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"--at {outside[0]:g}: {args.parameter} must lie in its box, {box.low:g}-{box.high:g}")
     if args.evaluations < len(FITTED):
         parser.error(f"--evaluations {args.evaluations}: the first simplex alone needs {len(FITTED)}")
+    start_from = None if args.start is None else kept_start(parser, *args.start)
     part = None if args.out is None else args.out.with_name(args.out.name + ".part")
     if args.out is not None and (args.out.exists() or part.exists()):
         parser.error(f"{args.out if args.out.exists() else part} is there already: give another --out")
@@ -215,15 +255,17 @@ def main(argv: list[str] | None = None) -> None:
     rows = [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
     log: list[dict] = []
     results: list[dict] = []
-    known = list(members)
+    known = list(members) + ([] if start_from is None else [start_from])
     started = time.perf_counter()
     try:
         with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=args.workers) as evaluator:
             ensemble_t3 = np.array([t3_cells(evaluator, m) for m, _ in members])  # (members, cells)
-            for value in args.at:
-                start, start_cost = nearest(args.parameter, value, known)
+            for i, value in enumerate(args.at):
+                start, start_cost = start_from if i == 0 and start_from is not None else nearest(
+                    args.parameter, value, known)
+                from_kept = start_from is not None and start is start_from[0]
                 print(f"{args.parameter} {value:g}: from the set at {start[args.parameter]:.4g} (cost "
-                      f"{start_cost:.4f})", flush=True)
+                      f"{start_cost:.4f}{', ' + ' '.join(args.start) if from_kept else ''})", flush=True)
                 values, cost, cells = refit(evaluator, args.parameter, value, start, args.evaluations, log)
                 known.append((values, cost))
                 measured = calibrate._cells_of(cells, MEASURED_SEEDS)
@@ -231,7 +273,8 @@ def main(argv: list[str] | None = None) -> None:
                 t3 = t3_cells(evaluator, values)
                 ahead = lead_counts(rows, t3)[0].get("smc", 0)
                 results.append({"parameter": args.parameter, "at": value, "cost": cost, "under_cut": cost <= cut,
-                                "values": values, "measured_rmse_cells_within": within,
+                                "start": start, "start_cost": start_cost, "values": values,
+                                "measured_rmse_cells_within": within,
                                 "t3": [{**r, "twin_mean": m} for r, m in zip(rows, t3, strict=True)]})
                 print(f"  cost {cost:.4f} ({'under' if cost <= cut else 'over'} the cut by {abs(cost - cut):.4f}); "
                       f"{within} of {len(measured)} measured RMSE cells within 20 % (seeds 0-4); "
@@ -247,7 +290,10 @@ def main(argv: list[str] | None = None) -> None:
         elif part is not None:
             try:
                 part.write_text(json.dumps({"calibration": shown(path), "preset": digest, "cut": cut,
-                                            "evaluations_per_value": args.evaluations, "results": results,
+                                            "evaluations_per_value": args.evaluations,
+                                            "start": None if args.start is None else [shown(args.start[0]),
+                                                                                      float(args.start[1])],
+                                            "results": results,
                                             "evaluations": log, "wall_time_s": time.perf_counter() - started,
                                             "complete": len(results) == len(args.at)}, indent=1) + "\n")
                 if args.out.exists():  # it appeared while the trial ran: not replaced

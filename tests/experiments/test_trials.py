@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import importlib.util
+import json
 import pathlib
 import re
 
@@ -1135,11 +1136,24 @@ def test_the_twelfth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
     (["--at", "0.4", "--calibration", "missing.json"], "--calibration missing.json: cannot read it as JSON"),
     (["--at", "0.4", "--calibration", "kept.json"], "--calibration kept.json: not a calibration file with an ensemble"),
     (["--at", "0.4", "--out", "x.json"], "x.json.part is there already: give another --out"),
+    (["--at", "0.4", "--start", "kept.json", "x"], "--start kept.json x: AT must be a number"),
+    (["--at", "0.4", "--start", "missing.json", "0.5"], "--start missing.json: cannot read it as JSON"),
+    (["--at", "0.4", "--start", "kept.json", "0.5"], "--start kept.json: no kept result at 0.5"),
+    (["--at", "0.4", "--start", "start.json", "0.5", "--out", "new.json"],
+     "--start start.json: its result at 0.5 has not the fitted values and a finite cost"),
+    (["--at", "0.4", "--start", "start.json", "0.6"], "its result at 0.6 has not the fitted values and a finite cost"),
+    (["--at", "0.4", "--start", "start.json", "0.7"], "its result at 0.7 has not the fitted values and a finite cost"),
+    (["--at", "0.4", "--start", "start.json", "0.8"], "its result at 0.8 has load_friction outside its box, 0-0.6"),
+    (["--at", "0.4", "--start", "start.json", "0.9"], "--start start.json: 2 kept results at 0.9, so which to start"),
+    (["--at", "0.4", "--start", "broken.json", "0.5"], "--start broken.json: cannot read it as JSON"),
+    (["--at", "0.4", "--start", "null.json", "0.5"], "--start null.json: no kept result at 0.5"),
+    (["--check", "kept.json", "--start", "start.json", "0.5"], "--start starts a profile run now (--at)"),
 ])
 def test_the_profile_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch, tmp_path, argv, said):
     """A value outside the parameter's box, a budget under the first simplex, an --out that is there already or in no
-    folder or given with --check, --at with --check or neither, and a --check or --calibration file that is missing,
-    not JSON or not of its kind: one-line errors, before any evaluation (a run here fails at once)."""
+    folder or given with --check, --at with --check or neither, a --check, --calibration or --start file that is
+    missing, not JSON or not of its kind, and a --start value that is not a number or not kept: one-line errors,
+    before any evaluation (a run here fails at once) and with no file written."""
     from twin.experiments import calibrate
 
     def no_run(*args, **kwargs):
@@ -1150,10 +1164,21 @@ def test_the_profile_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch,
     (tmp_path / "kept.json").write_text("{}")
     (tmp_path / "broken.json").write_text("{")
     (tmp_path / "x.json.part").write_text("")  # a part kept by a run before
+    fitted = {"stiction": 1.5, "air_fraction": 0.04, "ccw_coulomb_scale": 1.1, "leak_conductance": 2e-14,
+              "load_friction": 0.3, "observer_gain": 400.0, "initial_pressure_fraction": 0.5}
+    (tmp_path / "start.json").write_text(json.dumps({"results": [
+        {"at": 0.5, "values": {"stiction": 1.5}, "cost": 0.6},  # not every fitted parameter
+        {"at": 0.6, "values": {**fitted, "air_fraction": "x"}, "cost": 0.6},  # a value not a number
+        {"at": 0.7, "values": fitted, "cost": float("nan")},  # no finite cost
+        {"at": 0.8, "values": {**fitted, "load_friction": 0.7}, "cost": 0.6},  # outside the box
+        {"at": 0.9, "values": fitted, "cost": 0.6}, {"at": 0.9, "values": fitted, "cost": 0.7}]}))  # two at one value
+    (tmp_path / "null.json").write_text('{"results": null}')
     with pytest.raises(SystemExit) as stop:
         _load("trial_profile_likelihood").main(argv)
     err = capsys.readouterr().err
     assert stop.value.code == 2 and said in err and "Traceback" not in err
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.json", "kept.json", "null.json", "start.json",
+                                                          "x.json.part"]
 
 
 def test_the_profile_trials_check_exits_1_when_a_kept_number_is_not_run_again(capsys, monkeypatch, tmp_path):
@@ -1194,9 +1219,11 @@ def test_the_profile_trials_check_exits_1_when_a_kept_number_is_not_run_again(ca
     assert lines[2].endswith("as kept: False; T3 cells as kept: True")
 
 
-# Each kept profile: its preset, its values in the order run, which were under the cut, and the 13.5 g vertical T3
-# cells (FF + PVA / sliding mode) as printed and as docs/investigations.md quotes them. The load friction ran on the
-# twelfth refit (stop 46), the others on the thirteenth (stop 47); the two have the same cut.
+# Each kept profile, by its file in examples/trial_profile_likelihood/: its preset, its values in the order run, which
+# were under the cut, and the 13.5 g vertical T3 cells (FF + PVA / sliding mode) as printed and as
+# docs/investigations.md quotes them. The load friction ran on the twelfth refit (stop 46), the others on the
+# thirteenth (stop 47); the two have the same cut. Those in longer/ are longer searches (48 evaluations a value, not
+# 24) from a kept refit, on the thirteenth (stop 48).
 PROFILES = {
     "load_friction": ("6bb9e9258023", [0.40, 0.45, 0.50, 0.10, 0.05], [True, True, False, False, True],
                       ["4.28 / 4.09", "4.87 / 4.50", "5.51 / 4.90", "3.11 / 2.79", "3.09 / 2.75"]),
@@ -1208,34 +1235,59 @@ PROFILES = {
                      ["3.78 / 3.94", "4.97 / 4.84", "3.91 / 3.56", "4.26 / 3.68"]),
     "observer_gain": ("13aadbb61885", [250.0, 150.0, 700.0, 900.0], [False, False, False, False],
                       ["3.56 / 3.49", "3.31 / 3.32", "4.21 / 3.95", "4.34 / 3.92"]),
+    "longer/load_friction_high": ("13aadbb61885", [0.50, 0.55, 0.60], [True, False, False],
+                                  ["5.51 / 4.91", "6.20 / 5.59", "7.25 / 6.59"]),
+    "longer/load_friction_0.10": ("13aadbb61885", [0.10], [True], ["3.16 / 2.80"]),
+    "longer/load_friction_0": ("13aadbb61885", [0.0], [False], ["3.09 / 2.74"]),
+    "longer/air_fraction_0.08": ("13aadbb61885", [0.08], [True], ["4.21 / 3.60"]),
+    "longer/observer_gain_250": ("13aadbb61885", [250.0], [True], ["3.37 / 3.45"]),
+    "longer/observer_gain_700": ("13aadbb61885", [700.0], [False], ["4.13 / 3.93"]),
+    "longer/stiction_2.10": ("13aadbb61885", [2.10], [False], ["3.03 / 2.87"]),
 }
+# The longer searches' starts: each file's --start (a kept file and the value of its result the first value starts
+# from).
+LONGER_STARTS = {
+    "longer/load_friction_high": ("load_friction", 0.50),  # the search at 0.50 that stopped over the cut, continued
+    "longer/load_friction_0.10": ("load_friction", 0.10),
+    "longer/load_friction_0": ("load_friction", 0.05),  # the box's bottom, from the nearest kept refit
+    "longer/air_fraction_0.08": ("air_fraction", 0.08),
+    "longer/observer_gain_250": ("observer_gain", 250.0),
+    "longer/observer_gain_700": ("observer_gain", 700.0),
+    "longer/stiction_2.10": ("load_friction", 0.05),  # another start: the breakaway at 2.10 N with little load friction
+}
+
+
+def _kept_profile(name: str) -> tuple[dict, str]:
+    folder = ROOT / "examples" / "trial_profile_likelihood"
+    return json.loads((folder / f"{name}.json").read_text()), (folder / f"{name}.txt").read_text()
 
 
 @pytest.mark.parametrize("name", list(PROFILES))
 def test_the_profile_trials_kept_files_are_what_their_text_and_the_docs_quote(name):
     """Each kept profile: run on its preset (its digest and the cut of the twelfth and thirteenth refits), complete,
-    the values in the order run, each result the lowest of its own 24 evaluations, and the printed costs, cells within
-    20 %, twelve T3 cells and leads those of the results, which docs/investigations.md quotes."""
-    import json
-
+    the values in the order run, each result the lowest of its own evaluations (24 a value; 48 in longer/), and the
+    printed costs, cells within 20 %, twelve T3 cells and leads those of the results, which docs/investigations.md
+    quotes."""
     from twin.experiments.validate import lead_counts
     from twin.plants.as_built import TWELFTH_REFIT_FILE, calibration_cost_line, preset_digest
 
     preset, at, under, vertical = PROFILES[name]
-    folder = ROOT / "examples" / "trial_profile_likelihood"
-    kept = json.loads((folder / f"{name}.json").read_text())
-    printed = (folder / f"{name}.txt").read_text()
+    kept, printed = _kept_profile(name)
+    budget = 48 if name.startswith("longer/") else 24
+    parameter = kept["results"][0]["parameter"]
     assert kept["preset"] == preset
     assert preset_digest(TWELFTH_REFIT_FILE) == "6bb9e9258023"
     assert kept["cut"] == sum(calibration_cost_line(TWELFTH_REFIT_FILE)) == 0.6468583228172117
-    assert kept["complete"] and len(kept["evaluations"]) == 24 * len(at)
-    assert [r["parameter"] for r in kept["results"]] == [name] * len(at)
+    assert kept["complete"] and kept["evaluations_per_value"] == budget
+    assert len(kept["evaluations"]) == budget * len(at)
+    assert [r["parameter"] for r in kept["results"]] == [parameter] * len(at)
+    assert name.split("/")[-1].startswith(parameter)
     assert [r["at"] for r in kept["results"]] == at
     assert [r["under_cut"] for r in kept["results"]] == under
     assert all(r["under_cut"] == (r["cost"] <= kept["cut"]) for r in kept["results"])
     for r in kept["results"]:  # each value's result is the lowest of its own evaluations
         own = [e["cost"] for e in kept["evaluations"] if e["at"] == r["at"]]
-        assert len(own) == 24 and r["cost"] == min(own) and r["values"][name] == r["at"]
+        assert len(own) == budget and r["cost"] == min(own) and r["values"][parameter] == r["at"]
     costs = [float(c) for c in re.findall(r"^  cost (\d\.\d+) \(", printed, re.M)]
     assert costs == [round(r["cost"], 4) for r in kept["results"]]
     shown = re.findall(r"^    T3 (\w+) +13\.5 g vertical +(\d+\.\d\d) ", printed, re.M)
@@ -1254,7 +1306,27 @@ def test_the_profile_trials_kept_files_are_what_their_text_and_the_docs_quote(na
                                  [t["twin_mean"] for t in r["t3"]])[0].get("smc", 0) for r in kept["results"]]
 
 
-@pytest.mark.slow  # about 30 s on 2 cores each: four or five parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
+@pytest.mark.parametrize("name", list(LONGER_STARTS))
+def test_each_longer_search_starts_from_the_kept_refit_it_names_and_first_gets_its_cost_again(name):
+    """A longer search's first value starts from the kept result its --start names (the values, that value's held
+    one replaced), and its first evaluation, that set itself, costs what the kept file says to the last bit: the
+    search goes on from where the kept one stopped (or from the other start it names)."""
+    source, at = LONGER_STARTS[name]
+    kept, printed = _kept_profile(name)
+    before = {r["at"]: r for r in _kept_profile(source)[0]["results"]}[at]
+    first = kept["results"][0]
+    assert kept["start"] == [f"examples/trial_profile_likelihood/{source}.json", at]
+    assert first["start"] == before["values"] and first["start_cost"] == before["cost"]
+    assert kept["evaluations"][0]["values"] == {**before["values"], first["parameter"]: first["at"]}
+    if before["values"][first["parameter"]] == first["at"]:  # the same set: its cost again, bit for bit
+        assert kept["evaluations"][0]["cost"] == before["cost"]
+    for before_it, result in zip(kept["results"][:-1], kept["results"][1:], strict=True):  # later: from the one before
+        assert result["start"] == before_it["values"] and result["start_cost"] == before_it["cost"]
+    said = re.fullmatch(rf".*: from the set at \S+ \(cost {before['cost']:.4f}, (\S+) (\S+)\)", printed.splitlines()[1])
+    assert said and said[1] == f"examples/trial_profile_likelihood/{source}.json" and float(said[2]) == at
+
+
+@pytest.mark.slow  # about 30 s on 2 cores each: one to five parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
 @pytest.mark.parametrize("name", list(PROFILES))
 def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys, name):
     try:  # exit 1 on a mismatch: the lines below then say which
@@ -1265,8 +1337,9 @@ def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys, name)
         code = stop.code
     lines = capsys.readouterr().out.splitlines()
     preset, at, _, _ = PROFILES[name]
+    parameter = _kept_profile(name)[0]["results"][0]["parameter"]
     assert code == 0, lines
-    assert lines[0].endswith(f"preset {preset}, {len(at)} values of {name}")
+    assert lines[0].endswith(f"preset {preset}, {len(at)} values of {parameter}")
     assert [float(line.split(":")[0]) for line in lines[1:]] == at
     assert all(line.endswith("as kept: True; T3 cells as kept: True") for line in lines[1:]), lines
 
@@ -1283,11 +1356,14 @@ def test_the_profile_trial_names_its_calibration_from_the_checkouts_root(tmp_pat
     assert trial.shown(tmp_path / "mine.json") == str(tmp_path / "mine.json")
 
 
-@pytest.mark.slow  # about 20 s on 2 cores: nine parameter sets on the eleven Chapter 5 cells x 5 seeds, five kept files
-def test_the_profile_orders_trial_prints_what_it_kept(capsys):
-    _load("trial_profile_orders").main([])
-    kept = (ROOT / "examples" / "trial_profile_likelihood" / "orders.txt").read_text()
-    assert capsys.readouterr().out == kept
+@pytest.mark.slow  # about 20 s and 8 s on 2 cores: nine and four parameter sets on the eleven Chapter 5 cells x 5 seeds
+@pytest.mark.parametrize("folder", ["", "longer/"])
+def test_the_profile_orders_trial_prints_what_it_kept(capsys, folder):
+    """Its output on the five kept files (by default) and on the seven longer searches' kept files (given in name
+    order), as kept beside them."""
+    kept = ROOT / "examples" / "trial_profile_likelihood" / folder
+    _load("trial_profile_orders").main([str(p) for p in sorted(kept.glob("*.json"))] if folder else [])
+    assert capsys.readouterr().out == (kept / "orders.txt").read_text()
 
 
 @pytest.mark.parametrize(("text", "said"), [
@@ -1319,14 +1395,20 @@ def test_the_profile_orders_trial_refuses_a_file_it_cannot_use_before_it_runs(ca
 def test_the_profile_orders_kept_text_pairs_each_reversed_t3_lead_with_a_wrong_chapter_5_order():
     """What docs/investigations.md reads from orders.txt: every refit under the cut with the measured Chapter 5
     order on all four trajectories has sliding mode ahead in all six T3 cells, and every one with FF + PVA ahead in
-    a T3 cell gets one or more trajectories' order wrong; nine refits, five with the order right on all four."""
-    lines = (ROOT / "examples" / "trial_profile_likelihood" / "orders.txt").read_text().splitlines()
-    found = [(int(a), int(b)) for a, b in (re.search(r"order right on (\d) of 4.*ahead in (\d) of 6", line).groups()
-                                           for line in lines if line.startswith("  "))]
-    assert len(found) == 9 and sum(right == 4 for right, _ in found) == 5
-    assert all(ahead == 6 for right, ahead in found if right == 4)
-    assert sorted(ahead for right, ahead in found if ahead < 6) == [0, 2, 3]
-    assert all(right < 4 for right, ahead in found if ahead < 6)
+    a T3 cell gets one or more trajectories' order wrong: nine refits of stop 46-47, five with the order right on all
+    four, and four of the longer searches (stop 48), one with it right on all four."""
+    found = {}
+    for folder in ("", "longer/"):
+        lines = (ROOT / "examples" / "trial_profile_likelihood" / folder / "orders.txt").read_text().splitlines()
+        found[folder] = [(int(a), int(b)) for a, b in (
+            re.search(r"order right on (\d) of 4.*ahead in (\d) of 6", line).groups()
+            for line in lines if line.startswith("  "))]
+    assert [len(f) for f in found.values()] == [9, 4]
+    assert [sum(right == 4 for right, _ in f) for f in found.values()] == [5, 1]
+    both = found[""] + found["longer/"]
+    assert all(ahead == 6 for right, ahead in both if right == 4)
+    assert sorted(ahead for right, ahead in both if ahead < 6) == [0, 2, 3, 4]
+    assert all(right < 4 for right, ahead in both if ahead < 6)
 
 
 @pytest.mark.parametrize(("heading", "folder", "member_count"), [
