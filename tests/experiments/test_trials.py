@@ -1326,6 +1326,20 @@ def test_each_longer_search_starts_from_the_kept_refit_it_names_and_first_gets_i
     assert said and said[1] == f"examples/trial_profile_likelihood/{source}.json" and float(said[2]) == at
 
 
+def test_investigations_md_quotes_the_longer_searches_as_kept():
+    """docs/investigations.md's stop-48 section gives each longer search's cost (4 places) and 13.5 g vertical T3
+    cells as the kept files hold them, in the order its table lists them."""
+    text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
+    section = text[text.index("## Longer searches where a refit stopped near the cut"):]
+    table = [line for line in section[:section.index("\n## ")].splitlines()
+             if line.startswith("| ") and not line.startswith("| parameter")]
+    quoted = [(re.search(r"(\d\.\d{4})", row)[1], re.search(r"(\d+\.\d\d / \d+\.\d\d)", row)[1]) for row in table]
+    kept = [(f"{r['cost']:.4f}", f"{a:.2f} / {b:.2f}") for name in PROFILES if name.startswith("longer/")
+            for r in _kept_profile(name)[0]["results"]
+            for a, b in [[t["twin_mean"] for t in r["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]]]
+    assert quoted == kept and len(quoted) == 9
+
+
 @pytest.mark.slow  # about 30 s on 2 cores each: one to five parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
 @pytest.mark.parametrize("name", list(PROFILES))
 def test_the_profile_trials_kept_results_run_again_to_the_last_bit(capsys, name):
