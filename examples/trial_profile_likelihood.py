@@ -260,12 +260,12 @@ def main(argv: list[str] | None = None) -> None:
     try:
         with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=args.workers) as evaluator:
             ensemble_t3 = np.array([t3_cells(evaluator, m) for m, _ in members])  # (members, cells)
-            for i, value in enumerate(args.at):
-                start, start_cost = start_from if i == 0 and start_from is not None else nearest(
-                    args.parameter, value, known)
-                from_kept = start_from is not None and start is start_from[0]
+            first = start_from  # --start's set, for the first value only
+            for value in args.at:
+                start, start_cost = first or nearest(args.parameter, value, known)
                 print(f"{args.parameter} {value:g}: from the set at {start[args.parameter]:.4g} (cost "
-                      f"{start_cost:.4f}{', ' + ' '.join(args.start) if from_kept else ''})", flush=True)
+                      f"{start_cost:.4f}{', ' + ' '.join(args.start) if first else ''})", flush=True)
+                first = None
                 values, cost, cells = refit(evaluator, args.parameter, value, start, args.evaluations, log)
                 known.append((values, cost))
                 measured = calibrate._cells_of(cells, MEASURED_SEEDS)

@@ -1262,6 +1262,12 @@ def _kept_profile(name: str) -> tuple[dict, str]:
     return json.loads((folder / f"{name}.json").read_text()), (folder / f"{name}.txt").read_text()
 
 
+def _vertical_13_5(result: dict) -> str:
+    """A kept result's 13.5 g vertical T3 cells as the docs quote them: "FF + PVA / sliding mode", in deg."""
+    ffpva, smc = [t["twin_mean"] for t in result["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]
+    return f"{ffpva:.2f} / {smc:.2f}"
+
+
 @pytest.mark.parametrize("name", list(PROFILES))
 def test_the_profile_trials_kept_files_are_what_their_text_and_the_docs_quote(name):
     """Each kept profile: run on its preset (its digest and the cut of the twelfth and thirteenth refits), complete,
@@ -1292,9 +1298,7 @@ def test_the_profile_trials_kept_files_are_what_their_text_and_the_docs_quote(na
     assert costs == [round(r["cost"], 4) for r in kept["results"]]
     shown = re.findall(r"^    T3 (\w+) +13\.5 g vertical +(\d+\.\d\d) ", printed, re.M)
     assert [f"{a[1]} / {b[1]}" for a, b in zip(shown[::2], shown[1::2], strict=True)] == vertical
-    means = [[t["twin_mean"] for t in r["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]
-             for r in kept["results"]]
-    assert [f"{a:.2f} / {b:.2f}" for a, b in means] == vertical
+    assert [_vertical_13_5(r) for r in kept["results"]] == vertical
     # The rest of what each value prints: the cells within 20 %, all twelve T3 cells, the lead.
     within = [int(n) for n in re.findall(r"^  cost .*; (\d+) of 21 measured RMSE cells within 20 %", printed, re.M)]
     assert within == [r["measured_rmse_cells_within"] for r in kept["results"]]
@@ -1326,6 +1330,24 @@ def test_each_longer_search_starts_from_the_kept_refit_it_names_and_first_gets_i
     assert said and said[1] == f"examples/trial_profile_likelihood/{source}.json" and float(said[2]) == at
 
 
+@pytest.mark.slow  # about 1 min on 2 cores: the 13 members' T3 cells, then 7 parameter sets on the fit's cells
+def test_a_run_from_a_kept_start_makes_the_kept_longer_searchs_first_evaluations_again(capsys, monkeypatch, tmp_path):
+    """The --start run path: run as the kept 0.10 N/N longer search was (from the checkout's root, --start given as
+    then), over its first simplex only, it prints the kept text's first two lines (but for the budget) and makes its
+    first seven evaluations again, values and costs to the last bit."""
+    kept, printed = _kept_profile("longer/load_friction_0.10")
+    monkeypatch.chdir(ROOT)
+    _load("trial_profile_likelihood").main(["--parameter", "load_friction", "--at", "0.10", "--evaluations", "7",
+                                            "--start", "examples/trial_profile_likelihood/load_friction.json",
+                                            "0.10", "--out", str(tmp_path / "short.json")])
+    head = capsys.readouterr().out.splitlines()[:2]
+    assert head == [printed.splitlines()[0].replace("over 48 evaluations", "over 7 evaluations"),
+                    printed.splitlines()[1]]
+    short = json.loads((tmp_path / "short.json").read_text())
+    assert short["start"] == kept["start"] and short["results"][0]["start"] == kept["results"][0]["start"]
+    assert short["evaluations"] == kept["evaluations"][:7]
+
+
 def test_investigations_md_quotes_the_longer_searches_as_kept():
     """docs/investigations.md's stop-48 section gives each longer search's cost (4 places) and 13.5 g vertical T3
     cells as the kept files hold them, in the order its table lists them."""
@@ -1334,9 +1356,8 @@ def test_investigations_md_quotes_the_longer_searches_as_kept():
     table = [line for line in section[:section.index("\n## ")].splitlines()
              if line.startswith("| ") and not line.startswith("| parameter")]
     quoted = [(re.search(r"(\d\.\d{4})", row)[1], re.search(r"(\d+\.\d\d / \d+\.\d\d)", row)[1]) for row in table]
-    kept = [(f"{r['cost']:.4f}", f"{a:.2f} / {b:.2f}") for name in PROFILES if name.startswith("longer/")
-            for r in _kept_profile(name)[0]["results"]
-            for a, b in [[t["twin_mean"] for t in r["t3"] if t["payload_g"] == 13.5 and t["orientation"] == "vertical"]]]
+    kept = [(f"{r['cost']:.4f}", _vertical_13_5(r)) for name in PROFILES if name.startswith("longer/")
+            for r in _kept_profile(name)[0]["results"]]
     assert quoted == kept and len(quoted) == 9
 
 
