@@ -38,7 +38,10 @@ thirteenth refit, each run from a kept refit (``--start``): the load friction at
 and 0.60, at 0.10 (from its 0.10 refit) and at 0 (from its 0.05 refit); the free air at 8 % and the observer gain at
 250 and at 700 1/s, each from its refit; and the breakaway at 2.10 N from the load friction's 0.05 N/N refit, a start
 with little load friction. 432 evaluations in 2048 s on 2 cores, alone; kept in
-``examples/trial_profile_likelihood/longer/``, each file named for its parameter and values.
+``examples/trial_profile_likelihood/longer/``, each file named for its parameter and values. On 2026-11-29 (stop 49)
+four of those that had stopped over the cut went on, each from its own kept refit: the load friction at 0.55 and at
+0.60 (``--evaluations 96``), the breakaway at 2.10 N and the observer gain at 700 1/s (48); 288 evaluations in
+1339 s; kept in ``examples/trial_profile_likelihood/continued/``.
 
     python examples/trial_profile_likelihood.py --parameter load_friction --at 0.40 0.45 0.50 0.10 0.05 \
         --calibration twin/plants/data/twelfth_refit.json --out FILE

@@ -13,7 +13,8 @@ installed; no T3 measurement was seen.
 On 2026-11-28 (stop 47) its output on the five kept files was kept as
 ``examples/trial_profile_likelihood/orders.txt``; docs/investigations.md quotes it, and a slow test runs it again
 and gets that text. On 2026-11-29 (stop 48) its output on the longer searches' seven files (given in name order)
-was kept as ``examples/trial_profile_likelihood/longer/orders.txt``, also run again by a slow test.
+was kept as ``examples/trial_profile_likelihood/longer/orders.txt``, also run again by a slow test; on 2026-11-29
+(stop 49) its output on the four continued searches' files as ``continued/orders.txt``.
 
     python examples/trial_profile_orders.py [FILE ...] [--workers 2]
     python examples/trial_profile_orders.py examples/trial_profile_likelihood/longer/*.json

@@ -19,6 +19,22 @@ def _load(name: str):
     return module
 
 
+class _StubEvaluator:
+    """In place of calibrate.Evaluator where a test supplies the costs: runs nothing; its cells are the values."""
+
+    def __init__(self, **kwargs):
+        pass
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        return False
+
+    def cells(self, values, **kwargs):
+        return values
+
+
 @pytest.mark.slow  # about 25 s on 2 cores: twelve T1 cells, 40 seeds each
 def test_trial_payload_effect_prints_what_as_built_md_quotes(capsys):
     _load("trial_payload_effect").main()
@@ -1193,21 +1209,7 @@ def test_the_profile_trials_check_exits_1_when_a_kept_number_is_not_run_again(ca
     path = tmp_path / "kept.json"
     path.write_text(json.dumps(kept))
     trial = _load("trial_profile_likelihood")
-
-    class Stub:
-        def __init__(self, **kwargs):
-            pass
-
-        def __enter__(self):
-            return self
-
-        def __exit__(self, *exc):
-            return False
-
-        def cells(self, values, **kwargs):
-            return values
-
-    monkeypatch.setattr(trial.calibrate, "Evaluator", Stub)
+    monkeypatch.setattr(trial.calibrate, "Evaluator", _StubEvaluator)
     monkeypatch.setattr(trial.calibrate, "cost", lambda values: original[values["load_friction"]]["cost"])
     monkeypatch.setattr(trial, "t3_cells", lambda evaluator, values: [
         c["twin_mean"] for c in original[values["load_friction"]]["t3"]])
@@ -1223,7 +1225,8 @@ def test_the_profile_trials_check_exits_1_when_a_kept_number_is_not_run_again(ca
 # were under the cut, and the 13.5 g vertical T3 cells (FF + PVA / sliding mode) as printed and as
 # docs/investigations.md quotes them. The load friction ran on the twelfth refit (stop 46), the others on the
 # thirteenth (stop 47); the two have the same cut. Those in longer/ are longer searches (48 evaluations a value, not
-# 24) from a kept refit, on the thirteenth (stop 48).
+# 24) from a kept refit, on the thirteenth (stop 48); those in continued/ go on from where four of them stopped over
+# the cut (stop 49; 96 evaluations for the load friction, 48 for the others: BUDGETS).
 PROFILES = {
     "load_friction": ("6bb9e9258023", [0.40, 0.45, 0.50, 0.10, 0.05], [True, True, False, False, True],
                       ["4.28 / 4.09", "4.87 / 4.50", "5.51 / 4.90", "3.11 / 2.79", "3.09 / 2.75"]),
@@ -1243,7 +1246,14 @@ PROFILES = {
     "longer/observer_gain_250": ("13aadbb61885", [250.0], [True], ["3.37 / 3.45"]),
     "longer/observer_gain_700": ("13aadbb61885", [700.0], [False], ["4.13 / 3.93"]),
     "longer/stiction_2.10": ("13aadbb61885", [2.10], [False], ["3.03 / 2.87"]),
+    "continued/load_friction_0.55": ("13aadbb61885", [0.55], [True], ["6.27 / 5.62"]),
+    "continued/load_friction_0.60": ("13aadbb61885", [0.60], [False], ["7.23 / 6.61"]),
+    "continued/observer_gain_700": ("13aadbb61885", [700.0], [False], ["4.15 / 3.87"]),
+    "continued/stiction_2.10": ("13aadbb61885", [2.10], [False], ["3.03 / 2.87"]),
 }
+# Each kept profile's evaluations a value, by its folder, or by its name where that differs.
+BUDGETS = {"": 24, "longer": 48, "continued": 48, "continued/load_friction_0.55": 96,
+           "continued/load_friction_0.60": 96}
 # The longer searches' starts: each file's --start (a kept file and the value of its result the first value starts
 # from).
 LONGER_STARTS = {
@@ -1254,6 +1264,10 @@ LONGER_STARTS = {
     "longer/observer_gain_250": ("observer_gain", 250.0),
     "longer/observer_gain_700": ("observer_gain", 700.0),
     "longer/stiction_2.10": ("load_friction", 0.05),  # another start: the breakaway at 2.10 N with little load friction
+    "continued/load_friction_0.55": ("longer/load_friction_high", 0.55),  # each goes on from where one stopped
+    "continued/load_friction_0.60": ("longer/load_friction_high", 0.60),
+    "continued/observer_gain_700": ("longer/observer_gain_700", 700.0),
+    "continued/stiction_2.10": ("longer/stiction_2.10", 2.10),
 }
 
 
@@ -1271,7 +1285,7 @@ def _vertical_13_5(result: dict) -> str:
 @pytest.mark.parametrize("name", list(PROFILES))
 def test_the_profile_trials_kept_files_are_what_their_text_and_the_docs_quote(name):
     """Each kept profile: run on its preset (its digest and the cut of the twelfth and thirteenth refits), complete,
-    the values in the order run, each result the lowest of its own evaluations (24 a value; 48 in longer/), and the
+    the values in the order run, each result the lowest of its own evaluations (its BUDGETS a value), and the
     printed costs, cells within 20 %, twelve T3 cells and leads those of the results, which docs/investigations.md
     quotes."""
     from twin.experiments.validate import lead_counts
@@ -1279,7 +1293,7 @@ def test_the_profile_trials_kept_files_are_what_their_text_and_the_docs_quote(na
 
     preset, at, under, vertical = PROFILES[name]
     kept, printed = _kept_profile(name)
-    budget = 48 if name.startswith("longer/") else 24
+    budget = BUDGETS.get(name, BUDGETS[name.rpartition("/")[0]])
     parameter = kept["results"][0]["parameter"]
     assert kept["preset"] == preset
     assert preset_digest(TWELFTH_REFIT_FILE) == "6bb9e9258023"
@@ -1348,17 +1362,24 @@ def test_a_run_from_a_kept_start_makes_the_kept_longer_searchs_first_evaluations
     assert short["evaluations"] == kept["evaluations"][:7]
 
 
-def test_investigations_md_quotes_the_longer_searches_as_kept():
-    """docs/investigations.md's stop-48 section gives each longer search's cost (4 places) and 13.5 g vertical T3
-    cells as the kept files hold them, in the order its table lists them."""
+@pytest.mark.parametrize(("heading", "rows"), [
+    ("## Longer searches where a refit stopped near the cut", [f"longer/{n}" for n in (
+        "load_friction_high", "load_friction_0.10", "load_friction_0", "air_fraction_0.08", "observer_gain_250",
+        "observer_gain_700", "stiction_2.10")]),
+    ("## Searches continued where four stopped over the cut", [f"continued/{n}" for n in (
+        "load_friction_0.55", "load_friction_0.60", "observer_gain_700", "stiction_2.10")]),
+])
+def test_investigations_md_quotes_the_longer_searches_as_kept(heading, rows):
+    """docs/investigations.md's stop-48 and stop-49 sections give each search's cost (4 places) and 13.5 g vertical
+    T3 cells as the kept files hold them, in the order its first table lists them."""
     text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
-    section = text[text.index("## Longer searches where a refit stopped near the cut"):]
-    table = [line for line in section[:section.index("\n## ")].splitlines()
-             if line.startswith("| ") and not line.startswith("| parameter")]
+    section = text[text.index(heading):]
+    section = section[:section.index("\n## ")]
+    first = section[section.index("\n| parameter"):]
+    table = [line for line in first[:first.index("\n\n")].splitlines()[3:]]
     quoted = [(re.search(r"(\d\.\d{4})", row)[1], re.search(r"(\d+\.\d\d / \d+\.\d\d)", row)[1]) for row in table]
-    kept = [(f"{r['cost']:.4f}", _vertical_13_5(r)) for name in PROFILES if name.startswith("longer/")
-            for r in _kept_profile(name)[0]["results"]]
-    assert quoted == kept and len(quoted) == 9
+    kept = [(f"{r['cost']:.4f}", _vertical_13_5(r)) for name in rows for r in _kept_profile(name)[0]["results"]]
+    assert quoted == kept and len(quoted) == len(kept) >= len(rows)
 
 
 @pytest.mark.slow  # about 30 s on 2 cores each: one to five parameter sets on the fit's 21 cells x 10 seeds, T3's 12 x 5
@@ -1391,11 +1412,11 @@ def test_the_profile_trial_names_its_calibration_from_the_checkouts_root(tmp_pat
     assert trial.shown(tmp_path / "mine.json") == str(tmp_path / "mine.json")
 
 
-@pytest.mark.slow  # about 20 s and 8 s on 2 cores: nine and four parameter sets on the eleven Chapter 5 cells x 5 seeds
-@pytest.mark.parametrize("folder", ["", "longer/"])
+@pytest.mark.slow  # about 20, 8 and 2 s on 2 cores: nine, four and one parameter sets on 11 Chapter 5 cells x 5 seeds
+@pytest.mark.parametrize("folder", ["", "longer/", "continued/"])
 def test_the_profile_orders_trial_prints_what_it_kept(capsys, folder):
-    """Its output on the five kept files (by default) and on the seven longer searches' kept files (given in name
-    order), as kept beside them."""
+    """Its output on the five kept files (by default), on the seven longer searches' kept files and on the four
+    continued searches' (each given in name order), as kept beside them."""
     kept = ROOT / "examples" / "trial_profile_likelihood" / folder
     _load("trial_profile_orders").main([str(p) for p in sorted(kept.glob("*.json"))] if folder else [])
     assert capsys.readouterr().out == (kept / "orders.txt").read_text()
@@ -1431,19 +1452,143 @@ def test_the_profile_orders_kept_text_pairs_each_reversed_t3_lead_with_a_wrong_c
     """What docs/investigations.md reads from orders.txt: every refit under the cut with the measured Chapter 5
     order on all four trajectories has sliding mode ahead in all six T3 cells, and every one with FF + PVA ahead in
     a T3 cell gets one or more trajectories' order wrong: nine refits of stop 46-47, five with the order right on all
-    four, and four of the longer searches (stop 48), one with it right on all four."""
+    four, four of the longer searches (stop 48), one with it right on all four, and the one continued search under
+    the cut (stop 49), with sliding mode ahead in five cells and T1's order wrong."""
     found = {}
-    for folder in ("", "longer/"):
+    for folder in ("", "longer/", "continued/"):
         lines = (ROOT / "examples" / "trial_profile_likelihood" / folder / "orders.txt").read_text().splitlines()
         found[folder] = [(int(a), int(b)) for a, b in (
             re.search(r"order right on (\d) of 4.*ahead in (\d) of 6", line).groups()
             for line in lines if line.startswith("  "))]
-    assert [len(f) for f in found.values()] == [9, 4]
-    assert [sum(right == 4 for right, _ in f) for f in found.values()] == [5, 1]
-    both = found[""] + found["longer/"]
+    assert [len(f) for f in found.values()] == [9, 4, 1]
+    assert [sum(right == 4 for right, _ in f) for f in found.values()] == [5, 1, 0]
+    both = found[""] + found["longer/"] + found["continued/"]
     assert all(ahead == 6 for right, ahead in both if right == 4)
-    assert sorted(ahead for right, ahead in both if ahead < 6) == [0, 2, 3, 4]
+    assert sorted(ahead for right, ahead in both if ahead < 6) == [0, 2, 3, 4, 5]
     assert all(right < 4 for right, ahead in both if ahead < 6)
+
+
+# The fresh-seed trial's kept runs: on seeds 40-79 (stop 49, its reading written before it ran), then on 40-119
+# (decided after seeing that one, taking its costs on 40-79 and running 80-119), by the number of their seed sets.
+FRESH = {"costs": 4, "costs_40-119": 8}
+
+
+def _fresh(name: str) -> tuple[dict, str]:
+    folder = ROOT / "examples" / "trial_fresh_seed_costs"
+    return json.loads((folder / f"{name}.json").read_text()), (folder / f"{name}.txt").read_text()
+
+
+@pytest.mark.parametrize("name", list(FRESH))
+def test_the_fresh_seed_trials_kept_costs_are_every_kept_set_read_by_its_fixed_rule(name):
+    """The kept fresh-seed costs: complete, on seeds from 40 in sets of ten, the committed file's 13 members (member
+    0 the committed preset) then every kept profile result in the trial's order, each set's mean, paired difference to
+    member 0, its standard error and reading recomputed from its costs, and the printed text the kept numbers. The
+    longer run's costs on 40-79 are the first run's."""
+    import math
+
+    from twin.plants.as_built import (
+        CALIBRATION_FILE,
+        calibration_cost_line,
+        ensemble_costs,
+        ensemble_values,
+        preset_digest,
+    )
+
+    trial = _load("trial_fresh_seed_costs")
+    kept, printed = _fresh(name)
+    count = FRESH[name]
+    members = ensemble_values(CALIBRATION_FILE)
+    profile_results = [r for path in trial.kept_files() for r in json.loads(path.read_text())["results"]]
+    assert kept["complete"] and kept["preset"] == preset_digest(CALIBRATION_FILE) == "13aadbb61885"
+    assert kept["noise"] == calibration_cost_line(CALIBRATION_FILE)[1]
+    assert kept["fresh_seed_sets"] == [list(range(s, s + 10)) for s in range(40, 40 + 10 * count, 10)]
+    if count > 4:
+        assert kept["reused"] == "examples/trial_fresh_seed_costs/costs.json"
+        assert [s["fresh_costs"][:4] for s in kept["sets"]] == [s["fresh_costs"] for s in _fresh("costs")[0]["sets"]]
+    sets = kept["sets"]
+    assert len(sets) == len(members) + len(profile_results) == 13 + 34
+    assert [s["values"] for s in sets] == members + [r["values"] for r in profile_results]
+    assert [s["kept_cost"] for s in sets[len(members):]] == [r["cost"] for r in profile_results]
+    assert [s["kept_cost"] for s in sets[:len(members)]] == ensemble_costs(CALIBRATION_FILE)
+    base = sets[0]["fresh_costs"]
+    assert sets[0]["reading"] == "the best" and sets[0]["kept_cost"] == calibration_cost_line(CALIBRATION_FILE)[0]
+    for s in sets:
+        differences = [a - b for a, b in zip(s["fresh_costs"], base, strict=True)]
+        mean = sum(differences) / count
+        error = math.sqrt(sum((d - mean) ** 2 for d in differences) / (count - 1) / count)
+        assert len(s["fresh_costs"]) == count
+        assert s["mean"] == pytest.approx(sum(s["fresh_costs"]) / count, abs=1e-12)
+        assert s["difference"] == pytest.approx(mean, abs=1e-12) and s["standard_error"] == pytest.approx(error)
+        if s is not sets[0]:
+            assert s["reading"] == trial.reading(s["difference"], s["standard_error"], kept["noise"])
+    lines = [line for line in printed.splitlines() if line.startswith("  ")]
+    assert [line.split(":")[0].strip() for line in lines] == [s["set"] for s in sets]
+    assert [re.search(r"mean (\d\.\d{4}); ([+-]\d\.\d{4}) ± (\d\.\d{4}): (.+)$", line).groups() for line in lines] == [
+        (f"{s['mean']:.4f}", f"{s['difference']:+.4f}", f"{s['standard_error']:.4f}", s["reading"]) for s in sets]
+
+
+@pytest.mark.parametrize(("readings", "said"), [
+    ((0.13, 0.05, 0.1229), "worse"),  # over two standard errors and the noise
+    ((0.13, 0.07, 0.1229), "not told apart"),  # over the noise, not two standard errors
+    ((0.11, 0.01, 0.1229), "not told apart"),  # over two standard errors, not the noise
+    ((-0.13, 0.05, 0.1229), "better"),
+    ((-0.11, 0.01, 0.1229), "not told apart"),
+])
+def test_the_fresh_seed_trials_reading_needs_both_the_noise_and_two_standard_errors(readings, said):
+    assert _load("trial_fresh_seed_costs").reading(*readings) == said
+
+
+@pytest.mark.parametrize(("args", "reuse", "said"), [
+    ([], None, "stopped/run.json: not a complete kept profile trial file"),
+    (["--workers", "0"], None, "--workers 0: at least 1"),
+    (["--out", "THERE"], None, "is there already: give another --out"),
+    (["--seed-sets", "1"], None, "--seed-sets 1: from 2 (a standard error needs two) to 16"),
+    (["--reuse", "REUSE"], "{", "cannot read it as JSON (JSONDecodeError)"),
+    (["--reuse", "REUSE"], '{"sets": [], "complete": false, "fresh_seed_sets": []}',
+     "not a complete kept fresh-seed trial file"),
+    (["--reuse", "REUSE"], '{"sets": [], "complete": true, "fresh_seed_sets": [], "preset": "6bb9e9258023"}',
+     "run on preset 6bb9e9258023, not the committed 13aadbb61885"),
+    (["--reuse", "REUSE", "--seed-sets", "2"], '{"sets": [], "complete": true, "preset": "13aadbb61885", '
+     '"fresh_seed_sets": [[50, 51, 52, 53, 54, 55, 56, 57, 58, 59]]}', "its seed sets are not the first of this run's 2"),
+])
+def test_the_fresh_seed_trial_refuses_bad_input_before_it_runs(capsys, monkeypatch, tmp_path, args, reuse, said):
+    """In one line, before any run or file: a kept profile file that is not a complete run, too few seed sets, and a
+    --reuse file that is not a complete kept fresh-seed run on the committed preset and this run's first seed sets."""
+    from twin.experiments import calibrate
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the trial started its runs")
+
+    trial = _load("trial_fresh_seed_costs")
+    monkeypatch.setattr(calibrate, "Evaluator", no_run)
+    kept = tmp_path / "kept"
+    if not args:  # the profile files the trial reads, one of them a stopped run
+        monkeypatch.setattr(trial, "KEPT", kept)
+        (kept / "stopped").mkdir(parents=True)
+        (kept / "stopped" / "run.json").write_text('{"results": [], "complete": false}')
+    if reuse is not None:
+        (tmp_path / "reuse.json").write_text(reuse)
+    (tmp_path / "there.json").write_text("kept")
+    argv = [{"REUSE": str(tmp_path / "reuse.json"), "THERE": str(tmp_path / "there.json")}.get(a, a) for a in args]
+    before = sorted(tmp_path.rglob("*"))
+    with pytest.raises(SystemExit) as stop:
+        trial.main([*argv, "--out", str(tmp_path / "costs.json")] if "--out" not in args else argv)
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and said in err and "Traceback" not in err
+    assert len(err.strip().splitlines()[-1]) < 200 and sorted(tmp_path.rglob("*")) == before
+
+
+@pytest.mark.slow  # about 80 s on 2 cores: two parameter sets on the fit's 21 cells x 80 seeds
+def test_the_fresh_seed_trials_kept_costs_run_again_to_the_last_bit():
+    """Member 0's fresh costs and the last kept set's on seeds 40-119 (as the longer run kept them), run again, to the
+    last bit."""
+    from twin.experiments import calibrate
+
+    trial = _load("trial_fresh_seed_costs")
+    kept, _ = _fresh("costs_40-119")
+    with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=2) as evaluator:
+        for s in (kept["sets"][0], kept["sets"][-1]):
+            assert trial.fresh_costs(evaluator, s["values"], 8) == s["fresh_costs"], s["set"]
 
 
 @pytest.mark.parametrize(("heading", "folder", "member_count"), [
@@ -1678,3 +1823,105 @@ def test_trial_initial_pressure_prints_what_investigations_md_quotes(capsys):
         "T3, held 3 s at the start angle first (FF+PVA / SMC): "
         "0gH 2.50 / 2.28 | 6.5gH 2.69 / 2.41 | 13.5gH 2.88 / 2.55 | 0gV 2.47 / 2.22 | 6.5gV 2.65 / 2.41 | 13.5gV 3.70 / 3.51 | SMC ahead on 6 of 6",
     ]
+
+
+def test_the_fresh_seed_trial_prints_the_kept_roughness(capsys):
+    """--roughness (no runs) prints the kept roughness.txt, and docs/investigations.md quotes its first and last bins'
+    medians and the first's 90th percentile."""
+    _load("trial_fresh_seed_costs").main(["--roughness"])
+    printed = capsys.readouterr().out
+    assert printed == (ROOT / "examples" / "trial_fresh_seed_costs" / "roughness.txt").read_text()
+    bins = re.findall(r"of the box: \d+ pairs, median (\d\.\d{3}), 90th percentile (\d\.\d{3})", printed)
+    text = " ".join((ROOT / "docs" / "investigations.md").read_text(encoding="utf-8").split())
+    assert f"differ in cost by {bins[0][0]} (median; 90th percentile {bins[0][1]})" in text
+    assert f"10-20 % apart ({bins[-1][0]};" in text
+
+
+def test_investigations_md_counts_the_fresh_seed_readings_as_kept():
+    """docs/investigations.md's stop-49 table: the distinct sets' readings on 40-79 and on 40-119, by members (but
+    member 0, the best), profile refits under the cut on the fit's seeds and those over it, as the kept files give
+    them."""
+    from twin.plants.as_built import CALIBRATION_FILE, calibration_cost_line
+
+    cut = sum(calibration_cost_line(CALIBRATION_FILE))
+    columns = []
+    for name in FRESH:
+        distinct: dict[tuple, dict] = {}
+        for s in _fresh(name)[0]["sets"]:
+            distinct.setdefault(tuple(sorted(s["values"].items())), s)
+        groups = {"members": [], "under": [], "over": []}
+        for s in list(distinct.values())[1:]:
+            group = "members" if s["set"].startswith("member") else "under" if s["kept_cost"] <= cut else "over"
+            groups[group].append(s["reading"])
+        columns.append({g: " / ".join(str(r.count(k)) for k in ("worse", "not told apart", "better"))
+                        for g, r in groups.items()})
+    text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
+    section = text[text.index("## Searches continued where four stopped over the cut"):]
+    rows = {line.split(" | ")[0]: line.split(" | ")[1:] for line in section.splitlines()
+            if line.startswith("| 1")}
+    assert rows["| 13 members (member 0 the best)"][0] == columns[0]["members"]
+    assert rows["| 13 members (member 0 the best)"][1].startswith(columns[1]["members"])
+    assert rows["| 12 profile refits under the cut"] == [columns[0]["under"], columns[1]["under"] + " |"]
+    assert rows["| 19 profile refits over the cut"] == [columns[0]["over"], columns[1]["over"] + " |"]
+
+
+def test_the_fresh_seed_trial_reuses_a_kept_cost_only_for_the_same_set_and_values(capsys, monkeypatch, tmp_path):
+    """--reuse hands a set the kept costs of the row with its label and the same values, and none to a row whose
+    values differ or a set the file does not hold; those run every seed set."""
+    from twin.experiments import calibrate
+
+    trial = _load("trial_fresh_seed_costs")
+    kept, _ = _fresh("costs")
+    other = {**kept["sets"][1]["values"], "air_fraction": 0.05}
+    rows = [kept["sets"][0], {**kept["sets"][1], "values": other}]  # member 0 as kept; member 1 with other values
+    (tmp_path / "reuse.json").write_text(json.dumps({**kept, "sets": rows}))
+    given = {}
+
+    def fresh(evaluator, values, count, known):
+        given[len(given)] = list(known)
+        return list(known) + [1.0] * (count - len(known))
+
+    monkeypatch.setattr(calibrate, "Evaluator", _StubEvaluator)
+    monkeypatch.setattr(trial, "fresh_costs", fresh)
+    trial.main(["--seed-sets", "6", "--reuse", str(tmp_path / "reuse.json"), "--out", str(tmp_path / "out.json")])
+    capsys.readouterr()
+    assert given[0] == kept["sets"][0]["fresh_costs"] and given[1] == [] and given[2] == []
+    assert len(given) == len(kept["sets"]) and all(given[i] == [] for i in range(1, len(given)))
+    out = json.loads((tmp_path / "out.json").read_text())
+    assert out["complete"] and out["reused"] == str(tmp_path / "reuse.json")
+    assert out["sets"][0]["fresh_costs"] == kept["sets"][0]["fresh_costs"] + [1.0, 1.0]
+
+
+def test_investigations_md_quotes_the_fresh_seed_numbers_as_kept():
+    """The stop-49 section's numbers from the fresh-seed runs: the best's costs, the median and range of the cost's
+    rise from seeds 0-9 to 40-119 over the distinct sets, member 4's cost, and the differences it quotes."""
+    import statistics
+
+    four, _ = _fresh("costs")
+    eight, _ = _fresh("costs_40-119")
+    text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
+    section = " ".join(text[text.index("## Searches continued where four stopped over the cut"):].split())
+    section = section[:section.index(" ## ")]
+    best = eight["sets"][0]
+    assert f"costs {best['kept_cost']:.3f} there, {four['sets'][0]['mean']:.3f} on 40-79 and {best['mean']:.3f}" in section
+    distinct = {tuple(sorted(s["values"].items())): s for s in reversed(eight["sets"])}.values()
+    rise = [s["mean"] - s["kept_cost"] for s in distinct]
+    assert len(rise) == 44
+    assert f"0.17 above the one on 0-9 (median; {min(rise):.2f} to +{max(rise):.2f})" in section
+    assert round(statistics.median(rise), 2) == 0.17
+    by = {s["set"]: s for s in eight["sets"]}
+    by4 = {s["set"]: s for s in four["sets"]}
+    assert f"({by['member 4']['mean']:.3f} on 40-119" in section and by["member 4"]["reading"] == "better"
+
+    def pm(s):
+        return f"{s['difference']:+.3f} ± {s['standard_error']:.3f}"
+
+    for quoted in (pm(by4["longer/observer_gain_250.json observer_gain 250"]),
+                   pm(by["longer/observer_gain_250.json observer_gain 250"]),
+                   pm(by["stiction.json stiction 2.1"]), pm(by["longer/stiction_2.10.json stiction 2.1"]),
+                   pm(by["longer/load_friction_high.json load_friction 0.6"]),
+                   pm(by["continued/load_friction_0.55.json load_friction 0.55"]),
+                   pm(by["air_fraction.json air_fraction 0.02"])):
+        assert quoted in section, quoted
+    assert f"on 40-119 it costs {by['continued/load_friction_0.55.json load_friction 0.55']['mean']:.4f} against " \
+        f"the start's {by['longer/load_friction_high.json load_friction 0.55']['mean']:.4f}" in section
