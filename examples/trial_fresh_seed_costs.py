@@ -24,10 +24,9 @@ is not a complete profile run is refused in one line, before any run. ``--seed-s
 (default 4: 40-79); ``--reuse FILE`` takes the costs a kept run of this trial holds on its seed sets, when they are
 the first of this run's, for each set with the same label and values, and runs only the rest. ``--out FILE`` keeps
 the costs as JSON (refused if the file is there; written whole at the end; if it stops, what ran is written there,
-marked ``"complete": false``). Nothing is
-fitted or installed, and no T3 cell is run. ``--roughness`` runs nothing: it prints, over every pair of evaluations
-of one search in the kept profile files, how far apart their costs are by how far apart they lie in the box (kept as
-``examples/trial_fresh_seed_costs/roughness.txt``).
+marked ``"complete": false``). Nothing is fitted or installed, and no T3 cell is run. ``--roughness`` runs nothing:
+it prints, over every pair of evaluations of one search in the kept profile files, how far apart their costs are by
+how far apart they lie in the box (kept as ``examples/trial_fresh_seed_costs/roughness.txt``).
 
 On 2026-11-29 (stop 49) it ran on the 13 members and the 34 kept profile results: on seeds 40-79 (795 s on 2 cores,
 alone), kept as ``examples/trial_fresh_seed_costs/costs.json`` and ``.txt``; then, decided after seeing that run (one
