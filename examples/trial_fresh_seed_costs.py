@@ -20,7 +20,8 @@ and 91 % two-sided), and the noise carries the rule.
 
 The sets: the committed file's ensemble members, then every result of every complete kept profile file in
 ``examples/trial_profile_likelihood/`` and its folders (in name order), under the cut or over it. A kept file that
-is not a complete profile run is refused in one line, before any run. ``--seed-sets N`` runs N sets of ten from 40
+is not a complete profile run is refused in one line, before any run (``examples/kept_profiles.py`` reads them, for
+the three trials that do). ``--seed-sets N`` runs N sets of ten from 40
 (default 4: 40-79); ``--reuse FILE`` takes the costs a kept run of this trial holds on its seed sets, when they are
 the first of this run's, for each set with the same label and values, and runs only the rest. ``--out FILE`` keeps
 the costs as JSON (refused if the file is there; written whole at the end; if it stops, what ran is written there,
@@ -33,7 +34,8 @@ alone), kept as ``examples/trial_fresh_seed_costs/costs.json`` and ``.txt``; the
 set's standard error was too wide to read against the noise), on 40-119, reusing those costs and running 80-119,
 kept as ``costs_40-119.json`` and ``.txt``. docs/investigations.md records both. (``costs.json`` was written before
 ``--reuse`` existed, so it has no ``reused`` key.) A set kept twice (a member that is also a profile result, or a
-search that found nothing below its start) runs twice.
+search that found nothing below its start) ran twice in those runs, to the same costs; since stop 50 it runs once
+and its second row takes the first's costs.
 
     python examples/trial_fresh_seed_costs.py [--out FILE] [--seed-sets N] [--reuse FILE] [--workers 2]
     python examples/trial_fresh_seed_costs.py --seed-sets 8 --reuse examples/trial_fresh_seed_costs/costs.json \
@@ -54,45 +56,43 @@ import numpy as np
 from twin.experiments import calibrate
 from twin.plants.as_built import (
     CALIBRATION_FILE,
-    FITTED,
     calibration_cost_line,
     ensemble_costs,
     ensemble_values,
     preset_digest,
 )
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent  # the checkout
-KEPT = ROOT / "examples" / "trial_profile_likelihood"
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling module, however this one is loaded
+import kept_profiles  # noqa: E402
+from kept_profiles import shown  # noqa: E402
+
+KEPT = kept_profiles.KEPT
 SEED_SETS = 4  # sets of ten seeds from 40: validate's fresh seeds 40-79 (--seed-sets runs more, from 80)
 TIE = 2.0  # standard errors a mean paired difference must pass (and the noise) to tell a set from the best
 
 
 def kept_files() -> list[pathlib.Path]:
     """The kept profile files: the folder's own, then each sub-folder's, each in name order."""
-    return sorted(KEPT.glob("*.json")) + sorted(KEPT.glob("*/*.json"))
+    return kept_profiles.files(KEPT)
 
 
-def kept_sets(parser: argparse.ArgumentParser) -> list[tuple[str, dict[str, float], float]]:
-    """(label, values, cost on the fit seeds) of every kept profile result, or a one-line parser error for a file
-    that is not a complete kept profile run."""
-    sets = []
+def read_kept(parser: argparse.ArgumentParser) -> dict[str, dict]:
+    """Every kept profile file, read, by its name in the folder; a one-line parser error for one that is not a
+    complete kept profile run."""
+    files = {}
     for path in kept_files():
         name = str(path.relative_to(KEPT))
         try:
-            kept = json.loads(path.read_text())
-        except (OSError, UnicodeDecodeError, ValueError) as error:
-            parser.error(f"{name}: cannot read it as JSON ({error.__class__.__name__})")
-        results = kept.get("results") if isinstance(kept, dict) else None
-        if not (isinstance(results, list) and results and kept.get("complete") is True
-                and isinstance(kept.get("evaluations"), list) and all(
-                    isinstance(e, dict) and {"parameter", "at", "cost", "values"} <= set(e)
-                    for e in kept["evaluations"]) and all(
-                isinstance(r, dict) and isinstance(r.get("values"), dict) and isinstance(r.get("parameter"), str)
-                and set(r["values"]) == {f.name for f in FITTED} and isinstance(r.get("cost"), float)
-                and isinstance(r.get("at"), (int, float)) for r in results)):
-            parser.error(f"{name}: not a complete kept profile trial file")
-        sets += [(f"{name} {r['parameter']} {r['at']:g}", r["values"], r["cost"]) for r in results]
-    return sets
+            files[name] = kept_profiles.read(path)
+        except kept_profiles.KeptFileError as error:
+            parser.error(f"{name}: {error}")
+    return files
+
+
+def kept_sets(files: dict[str, dict]) -> list[tuple[str, dict[str, float], float]]:
+    """(label, values, cost on the fit seeds) of every result of the kept profile ``files``."""
+    return [(f"{name} {r['parameter']} {r['at']:g}", r["values"], r["cost"])
+            for name, file in files.items() for r in file["results"]]
 
 
 def reading(difference: float, error: float, noise: float) -> str:
@@ -102,14 +102,6 @@ def reading(difference: float, error: float, noise: float) -> str:
     if difference < -TIE * error and difference < -noise:
         return "better"
     return "not told apart"
-
-
-def shown(path: pathlib.Path) -> str:
-    """``path`` as a kept file names it: from the checkout's root when it lies in it, else as given."""
-    try:
-        return str(pathlib.Path(path).resolve().relative_to(ROOT))
-    except ValueError:
-        return str(path)
 
 
 def seed_sets(count: int) -> list[list[int]]:
@@ -148,15 +140,15 @@ def reused(parser: argparse.ArgumentParser, path: pathlib.Path, digest: str, cou
 ROUGHNESS_BINS = (0.0, 0.005, 0.01, 0.02, 0.05, 0.1, 0.2)  # the largest unit-box difference of a pair, bins' edges
 
 
-def roughness(files: list[pathlib.Path]) -> list[tuple[float, float, int, float, float]]:
+def roughness(files: list[dict]) -> list[tuple[float, float, int, float, float]]:
     """How far apart in cost two evaluations of one search are, by how far apart in the fitted box they are: over
-    every pair of evaluations at one held value in the kept profile ``files``, binned by the largest difference of
+    every pair of evaluations at one held value in the kept profile ``files`` (read), binned by the largest difference of
     their unit-box coordinates (every fitted parameter's share of its box), each bin's (low, high, pairs, median and
     90th percentile of the cost difference)."""
     distances, differences = [], []
-    for path in files:
+    for file in files:
         runs: dict[tuple, list[dict]] = {}
-        for e in json.loads(path.read_text())["evaluations"]:
+        for e in file["evaluations"]:
             runs.setdefault((e["parameter"], e["at"]), []).append(e)
         for run in runs.values():
             box = np.array([calibrate.unit_of(e["values"]) for e in run])
@@ -183,11 +175,11 @@ def main(argv: list[str] | None = None) -> None:
                         "evaluations of one search are, by how far apart they are in the box, and stop (no runs)")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
+    files = read_kept(parser)
     if args.roughness:
-        kept_sets(parser)  # the same files, refused the same way
-        print(f"every pair of evaluations at one held value in the {len(kept_files())} kept profile files: the cost "
+        print(f"every pair of evaluations at one held value in the {len(files)} kept profile files: the cost "
               "difference by the largest unit-box difference")
-        for low, high, pairs, median, top in roughness(kept_files()):
+        for low, high, pairs, median, top in roughness(list(files.values())):
             print(f"  {low:g}-{high:g} of the box: {pairs} pairs, median {median:.3f}, 90th percentile {top:.3f}")
         return
     if args.workers < 1:
@@ -202,7 +194,7 @@ def main(argv: list[str] | None = None) -> None:
     best_cost, noise = calibration_cost_line(CALIBRATION_FILE)
     members = [(f"member {i}", v, math.nan if c is None else c) for i, (v, c) in enumerate(zip(
         ensemble_values(CALIBRATION_FILE), ensemble_costs(CALIBRATION_FILE), strict=True))]
-    sets = members + kept_sets(parser)
+    sets = members + kept_sets(files)
     digest = preset_digest(CALIBRATION_FILE)
     before = {} if args.reuse is None else reused(parser, args.reuse, digest, args.seed_sets)
     if part is not None:
@@ -219,10 +211,13 @@ def main(argv: list[str] | None = None) -> None:
     try:
         with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=args.workers) as evaluator:
             base: list[float] = []
+            ran: dict[str, list[float]] = {}  # costs by values: a set kept twice runs once
             for label, values, kept_cost in sets:
                 kept_row = before.get(label)
                 known = kept_row["fresh_costs"] if kept_row and kept_row["values"] == values else []
-                costs = fresh_costs(evaluator, values, args.seed_sets, known)
+                same = json.dumps(values, sort_keys=True)
+                costs = ran.get(same) or fresh_costs(evaluator, values, args.seed_sets, known)
+                ran[same] = costs
                 base = base or costs  # member 0's, the first set's
                 differences = np.subtract(costs, base)
                 difference = float(differences.mean())

@@ -77,7 +77,10 @@ from twin.plants.as_built import (
     preset_digest,
 )
 
-ROOT = pathlib.Path(__file__).resolve().parent.parent  # the checkout
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling module, however this one is loaded
+import kept_profiles  # noqa: E402
+from kept_profiles import shown  # noqa: E402
+
 STEP = 0.10  # the initial simplex's step per refitted parameter, in unit-box coordinates (into the box)
 EVALUATIONS = 24  # per point: twin calibrate's simplex budget
 MEASURED_SEEDS = SEEDS  # the verdict's five runs, cut from the fit's ten
@@ -185,14 +188,6 @@ def kept_start(parser: argparse.ArgumentParser, path: str, at: str) -> tuple[dic
     return {k: float(v) for k, v in values.items()}, cost
 
 
-def shown(path) -> str:
-    """``path`` as a kept file names it: from the checkout's root when it lies in it, else as given."""
-    try:
-        return str(pathlib.Path(str(path)).resolve().relative_to(ROOT))
-    except ValueError:
-        return str(path)
-
-
 def main(argv: list[str] | None = None) -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     names = [f.name for f in FITTED]
@@ -215,11 +210,12 @@ def main(argv: list[str] | None = None) -> None:
             parser.error("--out keeps a profile run now (--at); --check writes nothing")
         if args.start is not None:
             parser.error("--start starts a profile run now (--at); --check runs the kept results as they are")
-        kept = read_json(parser, args.check, "--check")
-        results = kept.get("results")
-        if not isinstance(results, list) or not results or "preset" not in kept or not all(
-                isinstance(r, dict) and {"at", "parameter", "cost", "values", "t3"} <= set(r) for r in results):
-            parser.error(f"--check {args.check}: not a kept profile trial file (no results)")
+        try:  # a stopped run's results can be checked too
+            kept = kept_profiles.read(args.check, complete=False)
+        except kept_profiles.KeptFileError as error:
+            parser.error(f"--check {args.check}: {error}")
+        if "preset" not in kept:
+            parser.error(f"--check {args.check}: names no preset, so what it ran on is not known")
         if not check(kept, args.check, args.workers):
             sys.exit(1)
         return

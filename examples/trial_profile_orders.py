@@ -7,8 +7,9 @@ has sliding mode ahead in all six. This prints, for every refit under the cut in
 default every ``examples/trial_profile_likelihood/*.json``, in name order; each file's values in the order run, after
 a line naming the file and the preset it ran on), the Chapter 5 cells' order per trajectory on seeds 0-4 (as ``twin
 validate`` ranks them) against the measured order, and how many of the six T3 cells sliding mode leads in the kept
-file. A file that is not a complete kept profile run is refused in one line, before any run. Nothing is fitted or
-installed; no T3 measurement was seen.
+file. A file that is not a complete kept profile run is refused in one line, before any run, in the words of
+``examples/kept_profiles.py``, which reads them for the three trials. Nothing is fitted or installed; no T3
+measurement was seen.
 
 On 2026-11-28 (stop 47) its output on the five kept files was kept as
 ``examples/trial_profile_likelihood/orders.txt``; docs/investigations.md quotes it, and a slow test runs it again
@@ -23,43 +24,14 @@ was kept as ``examples/trial_profile_likelihood/longer/orders.txt``, also run ag
 from __future__ import annotations
 
 import argparse
-import json
 import pathlib
+import sys
 
 from twin.experiments import calibrate
 from twin.experiments.validate import PREDICTION_CELLS, SEEDS, controller_order, known_orders, lead_counts
-from twin.plants.as_built import FITTED
 
-KEPT = pathlib.Path(__file__).resolve().parent / "trial_profile_likelihood"
-
-
-CELLS = sorted((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # the T3 cells a kept result holds, by key
-
-
-def is_result(r) -> bool:
-    """Whether ``r`` is a result as the profile trial keeps it: its value, cost and cut, the fitted parameters' values
-    and the twelve T3 cells."""
-    return (isinstance(r, dict) and {"parameter", "at", "cost", "under_cut", "values", "t3"} <= set(r)
-            and isinstance(r["values"], dict) and set(r["values"]) == {f.name for f in FITTED}
-            and isinstance(r["t3"], list)
-            and all(isinstance(t, dict) and {"controller", "payload_g", "orientation", "twin_mean"} <= set(t)
-                    for t in r["t3"])
-            and sorted((t["controller"], t["payload_g"], t["orientation"]) for t in r["t3"]) == CELLS)
-
-
-def read_kept(parser: argparse.ArgumentParser, path: pathlib.Path) -> dict:
-    """The kept profile trial file ``path``, or a one-line parser error: not JSON, not a kept profile run
-    (:func:`is_result`), or not complete (a stopped run)."""
-    try:
-        kept = json.loads(path.read_text())
-    except (OSError, UnicodeDecodeError, ValueError) as error:
-        parser.error(f"{path}: cannot read it as JSON ({error.__class__.__name__})")
-    if not isinstance(kept, dict) or not isinstance(kept.get("results"), list) or not all(
-            is_result(r) for r in kept["results"]):
-        parser.error(f"{path}: not a kept profile trial file (no results as the trial writes them)")
-    if kept.get("complete") is not True:
-        parser.error(f"{path}: a stopped profile run (not complete): run it whole first")
-    return kept
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling module, however this one is loaded
+import kept_profiles  # noqa: E402
 
 
 def smc_ahead(result: dict) -> int:
@@ -79,8 +51,13 @@ def main(argv: list[str] | None = None) -> None:
     args = parser.parse_args(argv)
     if args.workers < 1:
         parser.error(f"--workers {args.workers}: give 1 or more")
-    paths = args.files or sorted(KEPT.glob("*.json"))
-    kept = [(path, read_kept(parser, path)) for path in paths]
+    paths = args.files or sorted(kept_profiles.KEPT.glob("*.json"))
+    kept = []
+    for path in paths:
+        try:
+            kept.append((path, kept_profiles.read(path)))
+        except kept_profiles.KeptFileError as error:
+            parser.error(f"{path}: {error}")
     keys = [k for k in calibrate.CELLS if k in calibrate.EXPERIMENT_CELLS]
     measured = controller_order([{"controller": k[0], "trajectory": k[1],
                                   "measured": calibrate.TARGET_OF[k].rmse_deg} for k in keys], "measured")

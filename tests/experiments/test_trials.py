@@ -1147,7 +1147,7 @@ def test_the_twelfth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
     (["--parameter", "friction", "--at", "0.4"], "invalid choice: 'friction'"),
     (["--check", "missing.json"], "--check missing.json: cannot read it as JSON (FileNotFoundError)"),
     (["--check", "broken.json"], "--check broken.json: cannot read it as JSON (JSONDecodeError)"),
-    (["--check", "kept.json"], "--check kept.json: not a kept profile trial file (no results)"),
+    (["--check", "kept.json"], "--check kept.json: not a kept profile trial file (no results as the trial writes them)"),
     (["--check", "kept.json", "--out", "y.json"], "--out keeps a profile run now (--at); --check writes nothing"),
     (["--at", "0.4", "--calibration", "missing.json"], "--calibration missing.json: cannot read it as JSON"),
     (["--at", "0.4", "--calibration", "kept.json"], "--calibration kept.json: not a calibration file with an ensemble"),
@@ -1448,6 +1448,65 @@ def test_the_profile_orders_trial_refuses_a_file_it_cannot_use_before_it_runs(ca
     assert stop.value.code == 2 and f"{path}: {said}" in err and "Traceback" not in err
 
 
+@pytest.mark.parametrize(("text", "said"), [
+    ("{", "cannot read it as JSON (JSONDecodeError)"),
+    ('{"results": [{"at": 1}], "complete": true}', "not a kept profile trial file (no results as the trial writes"),
+    ('{"results": [], "complete": false}', "a stopped profile run (not complete): run it whole first"),
+    ("KEPT_NO_EVALUATIONS", "not a kept profile trial file (no results as the trial writes"),
+    ("KEPT_NAN_COST", "not a kept profile trial file (no results as the trial writes"),
+])
+def test_the_three_trials_that_read_kept_profile_files_refuse_one_in_the_same_words(capsys, monkeypatch, tmp_path,
+                                                                                  text, said):
+    """The orders trial, the fresh-seed trial and the profile trial's --check read a kept profile file through one
+    reader (examples/kept_profiles.py), so each refuses a file that is not one with the same reason, in one line,
+    before any run (--check takes a stopped run's results, so a stopped run is refused by the other two only)."""
+    import copy
+
+    from twin.experiments import calibrate
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the trial started its runs")
+
+    good = json.loads((ROOT / "examples" / "trial_profile_likelihood" / "continued" / "stiction_2.10.json").read_text())
+    broken = copy.deepcopy(good)
+    if text == "KEPT_NO_EVALUATIONS":
+        del broken["evaluations"]
+    elif text == "KEPT_NAN_COST":
+        broken["results"][0]["cost"] = float("nan")
+    monkeypatch.setattr(calibrate, "Evaluator", no_run)
+    folder = tmp_path / "kept"
+    folder.mkdir()
+    path = folder / "run.json"
+    path.write_text(json.dumps(broken) if text.startswith("KEPT_") else text)
+    fresh = _load("trial_fresh_seed_costs")
+    monkeypatch.setattr(fresh, "KEPT", folder)
+    runs = [(_load("trial_profile_orders").main, [str(path)], f"{path}: {said}"),
+            (fresh.main, [], f"run.json: {said}"),
+            (_load("trial_profile_likelihood").main, ["--check", str(path)], f"--check {path}: {said}")]
+    for main, argv, words in runs[:2] if "stopped" in said else runs:
+        with pytest.raises(SystemExit) as stop:
+            main(argv)
+        err = capsys.readouterr().err
+        assert stop.value.code == 2 and words in err and "Traceback" not in err, (argv, err)
+
+
+def test_the_profile_trials_check_refuses_a_kept_file_that_names_no_preset(capsys, monkeypatch, tmp_path):
+    from twin.experiments import calibrate
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("the trial started its runs")
+
+    kept = json.loads((ROOT / "examples" / "trial_profile_likelihood" / "continued" / "stiction_2.10.json").read_text())
+    del kept["preset"]
+    path = tmp_path / "run.json"
+    path.write_text(json.dumps(kept))
+    monkeypatch.setattr(calibrate, "Evaluator", no_run)
+    with pytest.raises(SystemExit) as stop:
+        _load("trial_profile_likelihood").main(["--check", str(path)])
+    err = capsys.readouterr().err
+    assert stop.value.code == 2 and f"--check {path}: names no preset, so what it ran on is not known" in err
+
+
 def test_the_profile_orders_kept_text_pairs_each_reversed_t3_lead_with_a_wrong_chapter_5_order():
     """What docs/investigations.md reads from orders.txt: every refit under the cut with the measured Chapter 5
     order on all four trajectories has sliding mode ahead in all six T3 cells, and every one with FF + PVA ahead in
@@ -1539,7 +1598,7 @@ def test_the_fresh_seed_trials_reading_needs_both_the_noise_and_two_standard_err
 
 
 @pytest.mark.parametrize(("args", "reuse", "said"), [
-    ([], None, "stopped/run.json: not a complete kept profile trial file"),
+    ([], None, "stopped/run.json: a stopped profile run (not complete): run it whole first"),
     (["--workers", "0"], None, "--workers 0: at least 1"),
     (["--out", "THERE"], None, "is there already: give another --out"),
     (["--seed-sets", "1"], None, "--seed-sets 1: from 2 (a standard error needs two) to 16"),
@@ -1867,7 +1926,9 @@ def test_investigations_md_counts_the_fresh_seed_readings_as_kept():
 
 def test_the_fresh_seed_trial_reuses_a_kept_cost_only_for_the_same_set_and_values(capsys, monkeypatch, tmp_path):
     """--reuse hands a set the kept costs of the row with its label and the same values, and none to a row whose
-    values differ or a set the file does not hold; those run every seed set."""
+    values differ or a set the file does not hold; those run every seed set. A set kept twice (here three: two
+    members that are also profile results, and a longer search's result that its continued search kept again) runs
+    once, and its second row takes the first's costs."""
     from twin.experiments import calibrate
 
     trial = _load("trial_fresh_seed_costs")
@@ -1879,17 +1940,23 @@ def test_the_fresh_seed_trial_reuses_a_kept_cost_only_for_the_same_set_and_value
 
     def fresh(evaluator, values, count, known):
         given[len(given)] = list(known)
-        return list(known) + [1.0] * (count - len(known))
+        return list(known) + [float(len(given))] * (count - len(known))  # each run's own costs
 
     monkeypatch.setattr(calibrate, "Evaluator", _StubEvaluator)
     monkeypatch.setattr(trial, "fresh_costs", fresh)
     trial.main(["--seed-sets", "6", "--reuse", str(tmp_path / "reuse.json"), "--out", str(tmp_path / "out.json")])
     capsys.readouterr()
     assert given[0] == kept["sets"][0]["fresh_costs"] and given[1] == [] and given[2] == []
-    assert len(given) == len(kept["sets"]) and all(given[i] == [] for i in range(1, len(given)))
+    distinct = {json.dumps(s["values"], sort_keys=True) for s in kept["sets"]}
+    assert len(given) == len(distinct) == len(kept["sets"]) - 3 and all(given[i] == [] for i in range(1, len(given)))
     out = json.loads((tmp_path / "out.json").read_text())
     assert out["complete"] and out["reused"] == str(tmp_path / "reuse.json")
     assert out["sets"][0]["fresh_costs"] == kept["sets"][0]["fresh_costs"] + [1.0, 1.0]
+    by = {s["set"]: s["fresh_costs"] for s in out["sets"]}
+    assert by["load_friction.json load_friction 0.05"] == by["member 1"] == [2.0] * 6
+    assert by["load_friction.json load_friction 0.45"] == by["member 2"] == [3.0] * 6
+    assert by["continued/stiction_2.10.json stiction 2.1"] == by["longer/stiction_2.10.json stiction 2.1"]
+    assert len({tuple(c) for c in by.values()}) == len(distinct)
 
 
 def test_investigations_md_quotes_the_fresh_seed_numbers_as_kept():
