@@ -25,8 +25,10 @@ class KeptFileError(ValueError):
     """A file that is not a kept profile trial file (or not a complete one): its one-line reason."""
 
 
-def files(folder: pathlib.Path = KEPT) -> list[pathlib.Path]:
-    """The kept profile files in ``folder``: its own, then each sub-folder's, each in name order."""
+def files(folder: pathlib.Path | None = None) -> list[pathlib.Path]:
+    """The kept profile files in ``folder`` (by default :data:`KEPT`, read when called): its own, then each
+    sub-folder's, each in name order."""
+    folder = KEPT if folder is None else folder
     return sorted(folder.glob("*.json")) + sorted(folder.glob("*/*.json"))
 
 
@@ -42,8 +44,8 @@ def is_result(r) -> bool:
             and isinstance(r["cost"], float) and math.isfinite(r["cost"])
             and isinstance(r["values"], dict) and set(r["values"]) == {f.name for f in FITTED}
             and isinstance(r["t3"], list)
-            and all(isinstance(t, dict) and {"controller", "payload_g", "orientation", "twin_mean"} <= set(t)
-                    for t in r["t3"])
+            and all(isinstance(t, dict) and isinstance(t.get("controller"), str) and _number(t.get("payload_g"))
+                    and isinstance(t.get("orientation"), str) and _number(t.get("twin_mean")) for t in r["t3"])
             and sorted((t["controller"], t["payload_g"], t["orientation"]) for t in r["t3"]) == CELLS)
 
 
