@@ -99,14 +99,14 @@ def kept_t3(parser: argparse.ArgumentParser) -> dict[str, tuple[dict[str, float]
 
 
 def read_costs(parser: argparse.ArgumentParser, path: pathlib.Path, digest: str) -> dict:
-    """The kept fresh-seed run ``path``, or a one-line parser error: not such a complete run on the committed preset
-    whose members are the committed file's."""
+    """The kept fresh-seed run ``path``, or a one-line parser error: not such a complete run (on two or more seed
+    sets, as a standard error needs) on the committed preset whose members are the committed file's."""
     try:
         kept = json.loads(pathlib.Path(path).read_text())
     except (OSError, UnicodeDecodeError, ValueError) as error:
         parser.error(f"--costs {path}: cannot read it as JSON ({error.__class__.__name__})")
     if not (isinstance(kept, dict) and kept.get("complete") is True and isinstance(kept.get("sets"), list)
-            and kept["sets"] and isinstance(kept.get("fresh_seed_sets"), list) and kept["fresh_seed_sets"]
+            and kept["sets"] and isinstance(kept.get("fresh_seed_sets"), list) and len(kept["fresh_seed_sets"]) >= 2
             and all(isinstance(seeds, list) and seeds and all(isinstance(x, int) for x in seeds)
                     for seeds in kept["fresh_seed_sets"])
             and isinstance(kept.get("noise"), float) and all(

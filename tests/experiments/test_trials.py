@@ -2023,6 +2023,7 @@ def test_the_band_trial_refuses_no_workers(capsys):
     (None, "cannot read it as JSON (FileNotFoundError)"),
     ('{"sets": [], "complete": false}', "not a complete kept fresh-seed trial file"),
     ("NO_SEED_SETS", "not a complete kept fresh-seed trial file"),
+    ("ONE_SEED_SET", "not a complete kept fresh-seed trial file"),
     ("NULL_DIFFERENCE", "not a complete kept fresh-seed trial file"),
     ("NUMBER_LABEL", "not a complete kept fresh-seed trial file"),
     ("OTHER_PRESET", "run on preset 6bb9e9258023, not the committed 13aadbb61885"),
@@ -2038,6 +2039,10 @@ def test_the_band_trial_refuses_a_costs_file_it_cannot_read_beside_the_predictio
     by = {s["set"]: s for s in costs["sets"]}
     if text == "NO_SEED_SETS":
         del costs["fresh_seed_sets"]
+    elif text == "ONE_SEED_SET":  # no standard error to read a difference by
+        costs["fresh_seed_sets"] = costs["fresh_seed_sets"][:1]
+        for row in costs["sets"]:
+            row["fresh_costs"] = row["fresh_costs"][:1]
     elif text == "NULL_DIFFERENCE":
         costs["sets"][5]["difference"] = None
     elif text == "NUMBER_LABEL":
