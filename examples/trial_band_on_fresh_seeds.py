@@ -54,7 +54,7 @@ from twin.sim.scenario import CONTROLLER_LABELS
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling modules, however this one is loaded
 import kept_profiles  # noqa: E402
-from trial_fresh_seed_costs import reading  # noqa: E402
+from trial_fresh_seed_costs import paired, reading  # noqa: E402
 
 COSTS = kept_profiles.ROOT / "examples" / "trial_fresh_seed_costs" / "costs_40-119.json"
 REGISTERED = kept_profiles.ROOT / "twin" / "experiments" / "data"  # t3_prediction.csv, t3_prediction_members.csv
@@ -148,12 +148,10 @@ def stalls(sets: list[dict], t3: dict[str, list[float]], workers: int) -> tuple[
 
 def against(sets: list[dict], reference: dict, noise: float) -> list[dict]:
     """Of ``sets``, those the fresh-seed trial's reading does not call worse than ``reference`` (itself among them),
-    each paired with it on the same seed sets, as that trial pairs them with the best."""
+    each paired with it on the same seed sets by that trial's :func:`paired`, as it pairs them with the best."""
     kept = []
     for s in sets:
-        differences = np.subtract(s["fresh_costs"], reference["fresh_costs"])
-        error = float(differences.std(ddof=1) / math.sqrt(len(differences)))
-        if s is reference or reading(float(differences.mean()), error, noise) != "worse":
+        if s is reference or reading(*paired(s["fresh_costs"], reference["fresh_costs"]), noise) != "worse":
             kept.append(s)
     return kept
 

@@ -95,6 +95,13 @@ def kept_sets(files: dict[str, dict]) -> list[tuple[str, dict[str, float], float
             for name, file in files.items() for r in file["results"]]
 
 
+def paired(costs: list[float], base: list[float]) -> tuple[float, float]:
+    """The mean of ``costs`` minus ``base`` seed set by seed set, and its standard error (the differences' sample std
+    over the square root of their number)."""
+    differences = np.subtract(costs, base)
+    return float(differences.mean()), float(differences.std(ddof=1) / math.sqrt(len(differences)))
+
+
 def reading(difference: float, error: float, noise: float) -> str:
     """The fixed reading of a set's mean paired difference to the best (see the module docstring)."""
     if difference > TIE * error and difference > noise:
@@ -219,9 +226,7 @@ def main(argv: list[str] | None = None) -> None:
                 costs = ran.get(same) or fresh_costs(evaluator, values, args.seed_sets, known)
                 ran[same] = costs
                 base = base or costs  # member 0's, the first set's
-                differences = np.subtract(costs, base)
-                difference = float(differences.mean())
-                error = float(differences.std(ddof=1) / math.sqrt(len(differences)))
+                difference, error = paired(costs, base)
                 said = "the best" if not rows else reading(difference, error, noise)
                 rows.append({"set": label, "values": values, "kept_cost": None if math.isnan(kept_cost) else kept_cost,
                              "fresh_costs": costs, "mean": float(np.mean(costs)), "difference": difference,
