@@ -33,13 +33,27 @@ pointed out that the reference decides the count (2026-12-05, stop 50). No T3 me
 fitted or installed. Its output on the kept run is kept as ``examples/trial_fresh_seed_costs/band.txt``, and with
 ``--stalls`` as ``band_stalls.txt``.
 
-    python examples/trial_band_on_fresh_seeds.py [--costs FILE] [--stalls] [--workers 2]
+``--split`` (2026-12-06, stop 51; runs nothing) tests one design the team is to decide on: the fit re-ranking its
+candidates on fresh seeds alone. It splits the kept run's seed sets of ten into disjoint draws of four, two and one,
+and on each draw alone takes the set with the lowest mean there as the reference and keeps the sets the rule above
+does not read worse than it (on a single set of ten, where a paired difference has no standard error, the fit's own
+rule: a mean within the reference's plus the noise). Over every pair of disjoint draws it prints how many sets each
+draw keeps, how much two draws' kept sets overlap (the sets both keep over the sets either keeps), how often they
+pick the same reference, and per T3 cell how far the kept sets' lowest and highest means move from draw to draw.
+The draws are subsets of the same seeds (40-119 on the kept run), so the pairs are not independent samples; the
+candidates are the kept sets, not a search's. It was written after a first look at the same split in a scratch
+script (the four-set draws' overlap and the 13.5 g vertical tops) and kept as it first ran here. Its output on the
+kept run is ``band_split.txt``.
+
+    python examples/trial_band_on_fresh_seeds.py [--costs FILE] [--split] [--stalls] [--workers 2]
 """
 
 from __future__ import annotations
 
 import argparse
+import collections
 import csv
+import itertools
 import json
 import math
 import pathlib
@@ -156,6 +170,60 @@ def against(sets: list[dict], reference: dict, noise: float) -> list[dict]:
     return kept
 
 
+def draws(count: int, size: int) -> list[tuple[tuple[int, ...], tuple[int, ...]]]:
+    """Every pair of disjoint draws of ``size`` of the ``count`` seed sets (indices), each pair once, in order."""
+    chosen = list(itertools.combinations(range(count), size))
+    return [(a, b) for i, a in enumerate(chosen) for b in chosen[i + 1:] if not set(a) & set(b)]
+
+
+def rerank(sets: list[dict], draw: tuple[int, ...], noise: float) -> tuple[dict, list[dict]]:
+    """The design "re-rank the candidates on fresh seeds", on the seed sets ``draw`` alone: the reference (the set
+    with the lowest mean cost there) and the sets whose reading against it there is not worse, by :func:`against`'s
+    rule (the reference among them). On one seed set, where a paired difference has no standard error, the fit's own
+    rule instead: a mean within the reference's plus the noise."""
+    on = [{**s, "fresh_costs": [s["fresh_costs"][i] for i in draw]} for s in sets]
+    reference = min(on, key=lambda s: float(np.mean(s["fresh_costs"])))
+    if len(draw) == 1:
+        kept = [s for s in on if s["fresh_costs"][0] <= reference["fresh_costs"][0] + noise]
+    else:
+        kept = against(on, reference, noise)
+    return reference, kept
+
+
+def split_test(sets: list[dict], t3: dict[str, list[float]], noise: float, count: int) -> list[str]:
+    """Lines: for draws of 4, 2 and 1 of the ``count`` seed sets, :func:`rerank` on each of two disjoint draws
+    alone; how many sets each keeps, how much two disjoint draws' sets overlap (shared over either's), how often
+    they pick the same reference, and per T3 cell the span of their lowest and highest means over the draws."""
+    lines = []
+    for size in (4, 2, 1):
+        pairs = draws(count, size)
+        if not pairs:
+            continue
+        found = {draw: rerank(sets, draw, noise) for pair in pairs for draw in pair}
+        overlap = [len({s["set"] for s in found[a][1]} & {s["set"] for s in found[b][1]})
+                   / len({s["set"] for s in found[a][1]} | {s["set"] for s in found[b][1]}) for a, b in pairs]
+        sizes = [len(kept) for _, kept in found.values()]
+        references = collections.Counter(reference["set"] for reference, _ in found.values())
+        rule = "not shown worse than it" if size > 1 else "the fit's rule: a mean within its plus the noise"
+        lines.append(
+            f"  draws of {size} seed set{'s' if size > 1 else ''} ({10 * size} seeds; {len(found)} draws, {len(pairs)} "
+            f"disjoint pairs; kept: {rule}): kept {min(sizes)}-{max(sizes)} sets (median {np.median(sizes):g}); two "
+            f"disjoint draws share {np.median(overlap):.2f} of the sets either keeps (median; {min(overlap):.2f}-"
+            f"{max(overlap):.2f}); the same reference in {sum(found[a][0]['set'] == found[b][0]['set'] for a, b in pairs)}"
+            f" of {len(pairs)} pairs; references: "
+            + ", ".join(f"{name} {n}" for name, n in references.most_common()))
+        for i, (controller, _, payload, orientation) in enumerate(PREDICTION_CELLS):
+            spans = [spread(kept, t3, i) for _, kept in found.values()]
+            tops = collections.Counter(high_set for _, _, _, high_set in spans)
+            top, times = tops.most_common(1)[0]
+            lines.append(
+                f"    {CONTROLLER_LABELS[controller]:12} {payload:4g} g {orientation:10}: lowest "
+                f"{min(s[0] for s in spans):.2f}-{max(s[0] for s in spans):.2f}, highest "
+                f"{min(s[2] for s in spans):.2f}-{max(s[2] for s in spans):.2f} over the draws; the highest is "
+                f"{top}'s in {times} of {len(spans)}")
+    return lines
+
+
 def ratio(low: float, high: float, column: list[float]) -> float:
     """The range ``low``-``high`` as a multiple of the members' range ``column`` (lowest to highest); nan when the
     members agree to the last bit."""
@@ -169,6 +237,8 @@ def main(argv: list[str] | None = None) -> None:
                         help="a complete kept run of the fresh-seed trial (default: its seeds 40-119 run)")
     parser.add_argument("--stalls", action="store_true", help="run the sets not shown worse again (T3, seeds 0-4) "
                         "and print the runs that stall, cell by cell")
+    parser.add_argument("--split", action="store_true", help="test re-ranking on fresh seeds alone: the seed sets "
+                        "split into disjoint draws of 4, 2 and 1, the rule applied on each draw alone (runs nothing)")
     parser.add_argument("--workers", type=int, default=2)
     args = parser.parse_args(argv)
     if args.workers < 1:
@@ -219,6 +289,11 @@ def main(argv: list[str] | None = None) -> None:
               f"{times[0]:.1f}x-{times[-1]:.1f}x); sliding mode ahead in all six T3 cells on "
               f"{sum(lead.get('smc', 0) == 6 for lead in leads)} of {len(sets)} sets, FF + PVA ahead in one or more "
               f"on {sum(lead.get('ffpva', 0) > 0 for lead in leads)}")
+    if args.split:
+        print(f"re-ranked on fresh seeds, by split (a design the fit could use, tested on these costs): the "
+              f"{len(seeds)} seed sets of ten drawn apart; on each draw alone the reference is the set with the lowest "
+              f"mean there and the kept sets those the rule does not read worse than it; T3 means on seeds 0-4 (deg)")
+        print("\n".join(split_test(list(distinct.values()), t3, kept["noise"], len(seeds))))
     if args.stalls:
         sets = readings["not shown worse"]
         stalled, off = stalls(sets, t3, args.workers)

@@ -1926,6 +1926,79 @@ def test_the_band_trial_prints_what_it_kept(capsys):
     assert near == 15
 
 
+def test_the_band_trials_split_prints_what_it_kept_and_its_overlap_recomputed(capsys):
+    """--split runs nothing: its output on the kept run is band_split.txt as kept (band.txt first), and its numbers
+    for the draws of four seed sets are recomputed here from the kept costs, by the rule written out again: 35
+    disjoint pairs of draws, the two sharing 0.52 of the sets either keeps (median; 0.38-0.71), the same reference in
+    23; on single seed sets (the fit's rule) 0.34, the same reference in 3 of 28."""
+    import itertools
+    import math
+
+    import numpy as np
+
+    _load("trial_band_on_fresh_seeds").main(["--split"])
+    printed = capsys.readouterr().out
+    kept = (ROOT / "examples" / "trial_fresh_seed_costs" / "band_split.txt").read_text()
+    assert printed == kept
+    assert kept.startswith((ROOT / "examples" / "trial_fresh_seed_costs" / "band.txt").read_text())
+    costs, _ = _fresh("costs_40-119")
+    distinct = {json.dumps(s["values"], sort_keys=True): s for s in reversed(costs["sets"])}
+    table = np.array([s["fresh_costs"] for s in distinct.values()])  # (sets, 8)
+    noise = costs["noise"]
+
+    def kept_on(draw):
+        c = table[:, list(draw)]
+        best = int(np.argmin(c.mean(axis=1)))
+        if len(draw) == 1:
+            return best, {i for i in range(len(c)) if c[i, 0] <= c[best, 0] + noise}
+        d = c - c[best]
+        error = d.std(axis=1, ddof=1) / math.sqrt(len(draw))
+        return best, {i for i in range(len(c)) if i == best or not (d[i].mean() > 2 * error[i] and d[i].mean() > noise)}
+
+    for size, share, low, high, same, pairs in ((4, "0.52", "0.38", "0.71", 23, 35), (1, "0.34", "0.10", "0.65", 3, 28)):
+        chosen = list(itertools.combinations(range(8), size))
+        disjoint = [(a, b) for i, a in enumerate(chosen) for b in chosen[i + 1:] if not set(a) & set(b)]
+        assert len(disjoint) == pairs
+        found = [(kept_on(a), kept_on(b)) for a, b in disjoint]
+        overlap = [len(x & y) / len(x | y) for (_, x), (_, y) in found]
+        assert f"{np.median(overlap):.2f}" == share and f"{min(overlap):.2f}" == low and f"{max(overlap):.2f}" == high
+        assert sum(ra == rb for (ra, _), (rb, _) in found) == same
+        line = next(x for x in kept.splitlines() if x.startswith(f"  draws of {size} seed set"))
+        assert f"share {share} of the sets either keeps (median; {low}-{high}); the same reference in {same} of {pairs}" \
+            in line
+
+
+def test_the_docs_quote_the_band_trials_split():
+    """The stop-51 section's table and its 13.5 g vertical tops are band_split.txt's, and so are prediction.md's."""
+    printed = (ROOT / "examples" / "trial_fresh_seed_costs" / "band_split.txt").read_text()
+    text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
+    section = text[text.index("## Would re-ranking on fresh seeds settle"):].split("\n## ")[0]
+    rows = re.findall(r"^  draws of (\d) seed sets? \((\d+) seeds; \d+ draws, (\d+) disjoint pairs; kept: ([^)]*\)?[^)]*)\): "
+                      r"kept (\d+)-(\d+) sets \(median ([\d.]+)\); two disjoint draws share ([\d.]+) of the sets either "
+                      r"keeps \(median; ([\d.]+)-([\d.]+)\); the same reference in (\d+) of", printed, re.M)
+    assert [r[0] for r in rows] == ["4", "2", "1"]
+    for _, seeds, pairs, _, low, high, median, share, least, most, same in rows:
+        assert (f"| {seeds} | " in section and f"| {low}-{high} (median {median}) | {share} ({least}-{most}) | "
+                f"{same} of {pairs} |" in section), seeds
+    tops = re.findall(r"^    (FF \+ PVA|sliding mode) +13.5 g vertical  : lowest ([\d.-]+), highest ([\d.-]+) over the "
+                      r"draws; the highest is stiction.json stiction 2.1's in (\d+) of 70$", printed, re.M)
+    assert len(tops) == 2  # the two cells on the draws of four seed sets, the only ones with 70 draws
+    (_, ff_low, ff_high, times), (_, smc_low, smc_high, _) = tops
+    assert f"{ff_high} deg (FF + PVA) and {smc_high} (sliding mode)" in section
+    assert f"stop 47's breakaway refit at 2.1 N in {times} of the 70" in section
+    assert f"The lowest moves\n  less: {ff_low} and {smc_low}." in section
+    prediction = (ROOT / "docs" / "prediction.md").read_text(encoding="utf-8")
+    assert f"run {ff_high} /\n{smc_high} deg, set in {times} of 70 draws" in prediction
+    assert f"about half the same sets ({rows[0][7]}, median), and\ntoday's rule on ten seeds a third ({rows[2][7]})" in prediction
+
+
+def test_the_band_trials_draws_pair_each_two_disjoint_draws_once():
+    trial = _load("trial_band_on_fresh_seeds")
+    assert trial.draws(4, 2) == [((0, 1), (2, 3)), ((0, 2), (1, 3)), ((0, 3), (1, 2))]
+    assert trial.draws(3, 2) == []
+    assert len(trial.draws(8, 4)) == 35 and len(trial.draws(8, 2)) == 210 and len(trial.draws(8, 1)) == 28
+
+
 @pytest.mark.slow  # about 70 s on 2 cores: 36 parameter sets on T3's 12 cells x 5 seeds
 def test_the_band_trials_stalls_run_again_to_what_it_kept(capsys):
     """--stalls runs the 36 sets not shown worse again on T3: its output is band_stalls.txt as kept, every mean is the
