@@ -3,7 +3,8 @@ file names a path.
 
 ``examples/trial_profile_likelihood.py`` writes them; it (``--check``), ``trial_profile_orders.py`` and
 ``trial_fresh_seed_costs.py`` read them through :func:`read`, so the three refuse a file that is not one in the same
-words. A trial loads this module from its own folder (``sys.path``), however the trial itself is loaded.
+words. The trials that read them also take from here the T3 cells' rows (:func:`t3_rows`) and the key that makes two
+kept rows one set (:func:`same_set`). A trial loads this module from its own folder (``sys.path``), however the trial itself is loaded.
 """
 
 from __future__ import annotations
@@ -19,6 +20,17 @@ ROOT = pathlib.Path(__file__).resolve().parent.parent  # the checkout
 KEPT = ROOT / "examples" / "trial_profile_likelihood"  # the profile trial's kept files, and sub-folders of them
 CELLS = sorted((c, g, o) for c, _, g, o in PREDICTION_CELLS)  # the T3 cells a kept result holds, by key
 EVALUATION = {"parameter", "at", "cost", "values"}  # what a kept evaluation holds
+
+
+def t3_rows() -> list[dict]:
+    """The twelve T3 cells as ``twin validate``'s ``lead_counts`` reads them (controller, payload g, orientation), in
+    :data:`PREDICTION_CELLS`' order: a new list each call."""
+    return [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
+
+
+def same_set(values: dict[str, float]) -> str:
+    """One key for a parameter set's values, whatever label it is kept under: two rows with it are one set."""
+    return json.dumps(values, sort_keys=True)
 
 
 class KeptFileError(ValueError):

@@ -257,7 +257,7 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"--costs {args.costs}: no T3 cells on record for {missing[0]}")
     distinct: dict[str, dict] = {}
     for s in kept["sets"]:  # a set kept twice counts once, under its first label
-        distinct.setdefault(json.dumps(s["values"], sort_keys=True), s)
+        distinct.setdefault(kept_profiles.same_set(s["values"]), s)
     lowest = min(distinct.values(), key=lambda s: float(np.mean(s["fresh_costs"])))
     readings = {
         "not shown worse": [s for s in distinct.values() if s["reading"] != "worse"],
@@ -281,7 +281,7 @@ def main(argv: list[str] | None = None) -> None:
             low, low_set, high, high_set = spread(sets, t3, i)
             widest[name].append(ratio(low, high, column))
             print(f"    {name}: {low:.2f}-{high:.2f}, {widest[name][-1]:.1f}x (low {low_set}; high {high_set})")
-    cells = [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
+    cells = kept_profiles.t3_rows()
     for name, sets in readings.items():
         leads = [lead_counts(cells, t3[s["set"]])[0] for s in sets]
         times = sorted(w for w in widest[name] if not math.isnan(w))

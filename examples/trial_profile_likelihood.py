@@ -251,7 +251,7 @@ def main(argv: list[str] | None = None) -> None:
     print(f"preset {digest}: cut {cut:.4f} (cost {best:.4f} + noise {noise:.4f}); the ensemble's "
           f"{args.parameter} {min(lows):.4g}-{max(lows):.4g}; each value refitted over {args.evaluations} evaluations "
           f"of the other {len(FITTED) - 1}, fit seeds {calibrate.FIT_SEEDS[0]}-{calibrate.FIT_SEEDS[-1]}")
-    rows = [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
+    rows = kept_profiles.t3_rows()
     log: list[dict] = []
     results: list[dict] = []
     known = list(members) + ([] if start_from is None else [start_from])

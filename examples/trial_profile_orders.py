@@ -28,7 +28,7 @@ import pathlib
 import sys
 
 from twin.experiments import calibrate
-from twin.experiments.validate import PREDICTION_CELLS, SEEDS, controller_order, known_orders, lead_counts
+from twin.experiments.validate import SEEDS, controller_order, known_orders, lead_counts
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling module, however this one is loaded
 import kept_profiles  # noqa: E402
@@ -38,7 +38,7 @@ def smc_ahead(result: dict) -> int:
     """How many of the six T3 payload and orientation cells sliding mode leads in, from a kept result's cells
     (matched to :data:`PREDICTION_CELLS` by controller, payload and orientation)."""
     mean = {(t["controller"], t["payload_g"], t["orientation"]): t["twin_mean"] for t in result["t3"]}
-    rows = [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
+    rows = kept_profiles.t3_rows()
     return lead_counts(rows, [mean[(r["controller"], r["payload_g"], r["orientation"])] for r in rows])[0].get(
         "smc", 0)
 
