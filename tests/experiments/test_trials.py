@@ -2248,3 +2248,67 @@ def test_investigations_md_quotes_the_fresh_seed_numbers_as_kept():
         assert quoted in section, quoted
     assert f"on 40-119 it costs {by['continued/load_friction_0.55.json load_friction 0.55']['mean']:.4f} against " \
         f"the start's {by['longer/load_friction_high.json load_friction 0.55']['mean']:.4f}" in section
+
+
+def test_the_smc_lead_trials_ratio_error_and_reading_are_the_closed_forms():
+    """The lead's standard error is the first-order one, r sqrt((s1/m1)^2 + (s2/m2)^2); the reading is two combined
+    standard errors either way; the cells are the nine both laws were measured on, §8's four first."""
+    import math
+
+    trial = _load("trial_smc_lead")
+    ratio, error = trial.lead((1.0, 0.1), (2.0, 0.0))
+    assert ratio == 0.5 and error == pytest.approx(0.05, rel=1e-15)
+    ratio, error = trial.lead((1.2, 0.06), (1.5, 0.15))
+    assert ratio == pytest.approx(0.8) and error == pytest.approx(0.8 * math.sqrt(0.05 ** 2 + 0.1 ** 2), rel=1e-14)
+    assert trial.reading((0.95, 0.03), (0.75, 0.04)) == "weaker"  # 0.20 > 2 x 0.05
+    assert trial.reading((0.84, 0.03), (0.75, 0.04)) == "not told apart"  # 0.09 < 0.10
+    assert trial.reading((0.60, 0.03), (0.75, 0.04)) == "stronger"
+    assert trial.cells() == [(1, 0.0, "horizontal"), (2, 0.0, "horizontal"), (3, 0.0, "horizontal"),
+                             (4, 0.0, "horizontal"), (1, 6.5, "horizontal"), (1, 13.5, "horizontal"),
+                             (1, 0.0, "vertical"), (1, 6.5, "vertical"), (1, 13.5, "vertical")]
+
+
+@pytest.mark.slow  # about 50 s on 2 cores: nine cells x two laws x 45 seeds
+def test_the_smc_lead_trial_runs_again_to_what_it_kept(capsys):
+    _load("trial_smc_lead").main()
+    assert capsys.readouterr().out == (ROOT / "examples" / "trial_smc_lead" / "lead.txt").read_text()
+
+
+def test_the_docs_quote_the_smc_lead_trials_kept_output():
+    """investigations.md's stop-51 tables and counts, and as-built.md's leads, are lead.txt's; the rig's leads in it
+    are the thesis's means (reference.py) recomputed."""
+    from twin.experiments.calibrate import TARGET_OF
+
+    printed = (ROOT / "examples" / "trial_smc_lead" / "lead.txt").read_text()
+    text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
+    section = text[text.index("## Sliding mode's lead over FF + PVA, on the rig"):].split("\n## ")[0]
+    rows = re.findall(r"^  (T\d(?: [\d.]+ g \w+)?) +([\d.]+) ± ([\d.]+) +([\d.]+ ± [\d.]+) +([\d.]+ ± [\d.]+)  "
+                      r"([a-z ]+);", printed, re.M)
+    assert len(rows) == 9
+    for cell, rig, rig_error, first, fresh, said in rows:
+        assert f"| {cell} | {rig} ± {rig_error} | {first} | {fresh} | {said} |" in section, cell
+        t, g, o = int(cell[1]), float(cell.split()[1]) if " g " in cell else 0.0, cell.split()[-1] if " g " in cell \
+            else "horizontal"
+        assert rig == f"{TARGET_OF[('smc', t, g, o)].rmse_deg / TARGET_OF[('ffpva', t, g, o)].rmse_deg:.2f}"
+    summary = re.search(r"the twin's lead over the rig's: (x[\d.]+-x[\d.]+) \(median (x[\d.]+)\); weaker on (\d) of 9, "
+                        r"stronger on 0, not told apart on \d; the twin's lead smaller than the rig's on (\d) of 9",
+                        printed).groups()
+    assert (f"Its lead is {summary[0]} the rig's (median {summary[1]}): weaker on {summary[2]} of 9,\n  stronger on "
+            f"none, smaller on {summary[3]} of 9.") in section
+    moves = re.findall(r"^  (T1(?: [\d.]+ g \w+)?) +FF \+ PVA RMS [\d.]+ \((\d+)% of the run's squared error\), "
+                       r"([\d.]+)/s, error at opening ([\d.]+), advance ([\d.]+); sliding mode RMS [\d.]+ \((\d+)% of the "
+                       r"run's squared error\), ([\d.]+)/s, error at opening ([\d.]+), advance ([\d.]+)$", printed, re.M)
+    assert len(moves) == 6
+    for cell, _, _, ff_error, ff_advance, _, _, smc_error, smc_advance in moves:
+        assert f"  | {cell} | {ff_error}, {ff_advance} | {smc_error}, {smc_advance} |" in section, cell
+        assert float(smc_error) > float(ff_error)  # "in each of the six T1 cells ... at a larger error"
+    shares = [int(m[1]) for m in moves] + [int(m[5]) for m in moves]
+    rates = [float(m[2]) for m in moves] + [float(m[6]) for m in moves]
+    assert f"({moves[0][1]} % and {moves[0][5]} % on the flat cell" in section
+    assert f"{min(shares)}-{max(shares)} % over the six cells" in section
+    assert f"{min(rates):.0f}-{max(rates):.0f} openings a second" in section
+    flat_13 = next(r for r in rows if r[0] == "T1 13.5 g horizontal")
+    ffpva_13 = float(re.search(r"^  T1 13.5 g horizontal .*, [\d.]+ / ([\d.]+)$", printed, re.M).group(1))
+    assert f"(x{ffpva_13 / TARGET_OF[('ffpva', 1, 13.5, 'horizontal')].rmse_deg:.2f} on the fresh seeds)" in section
+    assert f"the rig's sliding\n  mode tracked at {flat_13[1]} of its FF + PVA and the twin's at {flat_13[4][:4]}" in section
+    assert f"on this cell ({flat_13[4][:4]} against\n  {flat_13[1]})" in (ROOT / "docs" / "as-built.md").read_text()
