@@ -4,7 +4,7 @@ file names a path.
 ``examples/trial_profile_likelihood.py`` writes them; it (``--check``), ``trial_profile_orders.py`` and
 ``trial_fresh_seed_costs.py`` read them through :func:`read`, so the three refuse a file that is not one in the same
 words. The trials that read them also take from here the T3 cells' rows (:func:`t3_rows`) and the key that makes two
-kept rows one set (:func:`same_set`). A trial loads this module from its own folder (``sys.path``), however the trial itself is loaded.
+kept rows one set (:func:`set_key`). A trial loads this module from its own folder (``sys.path``), however the trial itself is loaded.
 """
 
 from __future__ import annotations
@@ -28,8 +28,9 @@ def t3_rows() -> list[dict]:
     return [{"controller": c, "payload_g": g, "orientation": o} for c, _, g, o in PREDICTION_CELLS]
 
 
-def same_set(values: dict[str, float]) -> str:
-    """One key for a parameter set's values, whatever label it is kept under: two rows with it are one set."""
+def set_key(values: dict[str, float]) -> str:
+    """One key for a parameter set's values, whatever label it is kept under: two kept rows with the same key are one
+    set (the same values to the last bit; not ``twin calibrate``'s test of a repeated evaluation in the unit box)."""
     return json.dumps(values, sort_keys=True)
 
 

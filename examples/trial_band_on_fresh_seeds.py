@@ -36,14 +36,17 @@ fitted or installed. Its output on the kept run is kept as ``examples/trial_fres
 ``--split`` (2026-12-06, stop 51; runs nothing) tests one design the team is to decide on: the fit re-ranking its
 candidates on fresh seeds alone. It splits the kept run's seed sets of ten into disjoint draws of four, two and one,
 and on each draw alone takes the set with the lowest mean there as the reference and keeps the sets the rule above
-does not read worse than it (on a single set of ten, where a paired difference has no standard error, the fit's own
-rule: a mean within the reference's plus the noise). Over every pair of disjoint draws it prints how many sets each
-draw keeps, how much two draws' kept sets overlap (the sets both keep over the sets either keeps), how often they
-pick the same reference, and per T3 cell how far the kept sets' lowest and highest means move from draw to draw.
+does not read worse than it (on a single seed set, where a paired difference has no standard error, the fit's cut: a
+mean within the reference's plus the noise, without the fit's cap of 13 members). Over every pair of disjoint draws
+it prints how many sets each draw keeps (and how many are kept in every draw, in none and in some), how much two
+draws' kept sets overlap (the sets both keep over the sets either keeps), how often they pick the same reference,
+and per T3 cell how far the kept sets' lowest and highest means move from draw to draw, against the registered
+band's width, and the highest without the set most often highest.
 The draws are subsets of the same seeds (40-119 on the kept run), so the pairs are not independent samples; the
 candidates are the kept sets, not a search's. It was written after a first look at the same split in a scratch
-script (the four-set draws' overlap and the 13.5 g vertical tops) and kept as it first ran here. Its output on the
-kept run is ``band_split.txt``.
+script (the four-set draws' overlap and the 13.5 g vertical tops); the counts of sets kept in every draw, the ends'
+moves against the band and the highest without the set most often highest were added after a review of its first
+output. Its output on the kept run is ``band_split.txt``.
 
     python examples/trial_band_on_fresh_seeds.py [--costs FILE] [--split] [--stalls] [--workers 2]
 """
@@ -179,8 +182,8 @@ def draws(count: int, size: int) -> list[tuple[tuple[int, ...], tuple[int, ...]]
 def rerank(sets: list[dict], draw: tuple[int, ...], noise: float) -> tuple[dict, list[dict]]:
     """The design "re-rank the candidates on fresh seeds", on the seed sets ``draw`` alone: the reference (the set
     with the lowest mean cost there) and the sets whose reading against it there is not worse, by :func:`against`'s
-    rule (the reference among them). On one seed set, where a paired difference has no standard error, the fit's own
-    rule instead: a mean within the reference's plus the noise."""
+    rule (the reference among them). On one seed set, where a paired difference has no standard error, the fit's cut
+    instead: a mean within the reference's plus the noise (the fit's cap of 13 members left out)."""
     on = [{**s, "fresh_costs": [s["fresh_costs"][i] for i in draw]} for s in sets]
     reference = min(on, key=lambda s: float(np.mean(s["fresh_costs"])))
     if len(draw) == 1:
@@ -190,37 +193,49 @@ def rerank(sets: list[dict], draw: tuple[int, ...], noise: float) -> tuple[dict,
     return reference, kept
 
 
-def split_test(sets: list[dict], t3: dict[str, list[float]], noise: float, count: int) -> list[str]:
-    """Lines: for draws of 4, 2 and 1 of the ``count`` seed sets, :func:`rerank` on each of two disjoint draws
-    alone; how many sets each keeps, how much two disjoint draws' sets overlap (shared over either's), how often
-    they pick the same reference, and per T3 cell the span of their lowest and highest means over the draws."""
+def split_test(sets: list[dict], t3: dict[str, list[float]], noise: float, seed_sets: list[list[int]],
+               bands: list[float]) -> list[str]:
+    """Lines: for draws of 4, 2 and 1 of the ``seed_sets``, :func:`rerank` on each of two disjoint draws alone; how
+    many sets each keeps and how many are kept in every draw, in none and in some; how much two disjoint draws' sets
+    overlap (shared over either's); how often they pick the same reference; and per T3 cell how far the kept sets'
+    lowest and highest means move over the draws, beside ``bands`` (the registered 10-90 % band's width, per cell in
+    :data:`PREDICTION_CELLS`' order), and the highest once more without the set most often highest."""
     lines = []
     for size in (4, 2, 1):
-        pairs = draws(count, size)
+        pairs = draws(len(seed_sets), size)
         if not pairs:
             continue
         found = {draw: rerank(sets, draw, noise) for pair in pairs for draw in pair}
-        overlap = [len({s["set"] for s in found[a][1]} & {s["set"] for s in found[b][1]})
-                   / len({s["set"] for s in found[a][1]} | {s["set"] for s in found[b][1]}) for a, b in pairs]
-        sizes = [len(kept) for _, kept in found.values()]
+        names = {draw: {s["set"] for s in kept} for draw, (_, kept) in found.items()}
+        overlap = [len(names[a] & names[b]) / len(names[a] | names[b]) for a, b in pairs]
+        sizes = [len(kept) for kept in names.values()]
+        times_kept = [sum(s["set"] in kept for kept in names.values()) for s in sets]
         references = collections.Counter(reference["set"] for reference, _ in found.values())
-        rule = "not shown worse than it" if size > 1 else "the fit's rule: a mean within its plus the noise"
+        rule = "not shown worse than it" if size > 1 else "the fit's cut: a mean within its plus the noise, no cap"
         lines.append(
-            f"  draws of {size} seed set{'s' if size > 1 else ''} ({10 * size} seeds; {len(found)} draws, {len(pairs)} "
-            f"disjoint pairs; kept: {rule}): kept {min(sizes)}-{max(sizes)} sets (median {np.median(sizes):g}); two "
-            f"disjoint draws share {np.median(overlap):.2f} of the sets either keeps (median; {min(overlap):.2f}-"
-            f"{max(overlap):.2f}); the same reference in {sum(found[a][0]['set'] == found[b][0]['set'] for a, b in pairs)}"
-            f" of {len(pairs)} pairs; references: "
-            + ", ".join(f"{name} {n}" for name, n in references.most_common()))
+            f"  draws of {size} seed set{'s' if size > 1 else ''} ({sum(len(seed_sets[i]) for i in pairs[0][0])} seeds; "
+            f"{len(found)} draws, {len(pairs)} disjoint pairs; kept: {rule}): kept {min(sizes)}-{max(sizes)} sets "
+            f"(median {np.median(sizes):g}); of the {len(sets)}, {times_kept.count(len(found))} kept in every draw, "
+            f"{times_kept.count(0)} in none, {sum(0 < n < len(found) for n in times_kept)} in some; two disjoint draws "
+            f"share {np.median(overlap):.2f} of the sets either keeps (median; {min(overlap):.2f}-{max(overlap):.2f}); "
+            f"the same reference in {sum(found[a][0]['set'] == found[b][0]['set'] for a, b in pairs)} of {len(pairs)} "
+            "pairs; references: " + ", ".join(f"{name} {n}" for name, n in references.most_common()))
+        wider = {"lowest": 0, "highest": 0}  # cells where that end moves more than the registered band is wide
         for i, (controller, _, payload, orientation) in enumerate(PREDICTION_CELLS):
             spans = [spread(kept, t3, i) for _, kept in found.values()]
-            tops = collections.Counter(high_set for _, _, _, high_set in spans)
-            top, times = tops.most_common(1)[0]
+            lows, highs = [s[0] for s in spans], [s[2] for s in spans]
+            wider["lowest"] += max(lows) - min(lows) > bands[i]
+            wider["highest"] += max(highs) - min(highs) > bands[i]
+            top, times = collections.Counter(high_set for _, _, _, high_set in spans).most_common(1)[0]
+            without = [spread([s for s in kept if s["set"] != top], t3, i)[2] for _, kept in found.values()
+                       if any(s["set"] != top for s in kept)]
             lines.append(
-                f"    {CONTROLLER_LABELS[controller]:12} {payload:4g} g {orientation:10}: lowest "
-                f"{min(s[0] for s in spans):.2f}-{max(s[0] for s in spans):.2f}, highest "
-                f"{min(s[2] for s in spans):.2f}-{max(s[2] for s in spans):.2f} over the draws; the highest is "
-                f"{top}'s in {times} of {len(spans)}")
+                f"    {CONTROLLER_LABELS[controller]:12} {payload:4g} g {orientation:10}: lowest {min(lows):.2f}-"
+                f"{max(lows):.2f} (moves {max(lows) - min(lows):.2f}), highest {min(highs):.2f}-{max(highs):.2f} "
+                f"(moves {max(highs) - min(highs):.2f}) over the draws, the registered band {bands[i]:.2f} wide; the "
+                f"highest is {top}'s in {times} of {len(spans)}; without it {min(without):.2f}-{max(without):.2f}")
+        lines.append(f"    moving more than the registered band is wide: the highest in {wider['highest']} of "
+                     f"{len(PREDICTION_CELLS)} cells, the lowest in {wider['lowest']}")
     return lines
 
 
@@ -257,7 +272,7 @@ def main(argv: list[str] | None = None) -> None:
         parser.error(f"--costs {args.costs}: no T3 cells on record for {missing[0]}")
     distinct: dict[str, dict] = {}
     for s in kept["sets"]:  # a set kept twice counts once, under its first label
-        distinct.setdefault(kept_profiles.same_set(s["values"]), s)
+        distinct.setdefault(kept_profiles.set_key(s["values"]), s)
     lowest = min(distinct.values(), key=lambda s: float(np.mean(s["fresh_costs"])))
     readings = {
         "not shown worse": [s for s in distinct.values() if s["reading"] != "worse"],
@@ -291,9 +306,10 @@ def main(argv: list[str] | None = None) -> None:
               f"on {sum(lead.get('ffpva', 0) > 0 for lead in leads)}")
     if args.split:
         print(f"re-ranked on fresh seeds, by split (a design the fit could use, tested on these costs): the "
-              f"{len(seeds)} seed sets of ten drawn apart; on each draw alone the reference is the set with the lowest "
+              f"{len(seeds)} seed sets drawn apart; on each draw alone the reference is the set with the lowest "
               f"mean there and the kept sets those the rule does not read worse than it; T3 means on seeds 0-4 (deg)")
-        print("\n".join(split_test(list(distinct.values()), t3, kept["noise"], len(seeds))))
+        bands = [float(row["band_p90"]) - float(row["band_p10"]) for row in rows]
+        print("\n".join(split_test(list(distinct.values()), t3, kept["noise"], seeds, bands)))
     if args.stalls:
         sets = readings["not shown worse"]
         stalled, off = stalls(sets, t3, args.workers)

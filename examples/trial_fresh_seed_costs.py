@@ -222,7 +222,7 @@ def main(argv: list[str] | None = None) -> None:
             for label, values, kept_cost in sets:
                 kept_row = before.get(label)
                 known = kept_row["fresh_costs"] if kept_row and kept_row["values"] == values else []
-                same = kept_profiles.same_set(values)
+                same = kept_profiles.set_key(values)
                 costs = ran.get(same) or fresh_costs(evaluator, values, args.seed_sets, known)
                 ran[same] = costs
                 base = base or costs  # member 0's, the first set's

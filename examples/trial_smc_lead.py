@@ -36,15 +36,15 @@ import numpy as np
 
 from twin.envs.runner import run_many
 from twin.experiments.calibrate import TARGET_OF, TARGETS, THESIS_RUNS
-from twin.experiments.validate import FRESH_SEEDS as FRESH
-from twin.experiments.validate import SEEDS, pulse_statistics
+from twin.experiments.validate import FRESH_SEEDS, SEEDS, discharge_open, pulse_statistics
 from twin.physics.model import Orientation
+from twin.physics.trajectories import trajectory
+from twin.plants import plant
 from twin.plants.as_built import CALIBRATION_FILE, preset_digest
-from twin.sim.scenario import Scenario
+from twin.sim.scenario import CONTROLLER_LABELS, Scenario
 
 LAWS = ("ffpva", "smc")
-MOVE = 1.0  # s: T1's rise, its first segment
-TIE = 2.0  # combined standard errors
+TIE = 2.0  # combined standard errors, for the reading against the rig (:func:`against_rig`)
 
 
 def cells() -> list[tuple[int, float, str]]:
@@ -60,85 +60,94 @@ def lead(smc: tuple[float, float], ffpva: tuple[float, float]) -> tuple[float, f
     return ratio, ratio * math.hypot(smc[1] / smc[0], ffpva[1] / ffpva[0])
 
 
-def reading(twin: tuple[float, float], rig: tuple[float, float]) -> str:
-    difference, error = twin[0] - rig[0], math.hypot(twin[1], rig[1])
-    if difference > TIE * error:
-        return "weaker"
-    if difference < -TIE * error:
-        return "stronger"
-    return "not told apart"
+def against_rig(twin_lead: tuple[float, float], rig_lead: tuple[float, float]) -> tuple[str, float]:
+    """The reading of the twin's lead (ratio, standard error) against the rig's, and how far apart they are in
+    combined standard errors (z): "weaker" past :data:`TIE` of them above, "stronger" past it below, else "not told
+    apart"."""
+    z = (twin_lead[0] - rig_lead[0]) / math.hypot(twin_lead[1], rig_lead[1])
+    return ("weaker" if z > TIE else "stronger" if z < -TIE else "not told apart"), z
 
 
 def label(cell: tuple[int, float, str]) -> str:
-    trajectory, payload, orientation = cell
-    return f"T{trajectory}" + ("" if not payload and orientation == "horizontal" else f" {payload:g} g {orientation}")
+    t, payload, orientation = cell
+    return f"T{t}" + ("" if not payload and orientation == "horizontal" else f" {payload:g} g {orientation}")
+
+
+def move_statistics(result, move_end: float) -> dict:
+    """One T1 run's move (before ``move_end``, s): :func:`pulse_statistics` on it, its RMS error (deg) and that
+    error's share of the whole run's squared error."""
+    t = result.trace.time
+    inside = t < move_end
+    squared = np.square(result.scored_angle - result.trace.desired_angle)
+    return {**pulse_statistics(t[inside], result.trace.desired_angle[inside], result.scored_angle[inside],
+                               discharge_open(result.trace.valve_open)[inside]),
+            "rms_deg": math.degrees(float(np.sqrt(np.mean(squared[inside])))),
+            "share": float(squared[inside].sum() / squared.sum())}
 
 
 def main() -> None:
     keys = cells()
-    seeds = {"seeds 0-4": list(SEEDS), f"seeds {FRESH[0]}-{FRESH[-1]}": list(FRESH)}
-    jobs = [(law, cell, s) for law in LAWS for cell in keys for group in seeds.values() for s in group]
+    groups = {"seeds 0-4": SEEDS, f"seeds {FRESH_SEEDS[0]}-{FRESH_SEEDS[-1]}": FRESH_SEEDS}
+    fresh = list(groups)[1]
+    move_end = trajectory(1, spur_radius=plant("as-built").params.gears.spur_radius).segments[0].duration  # s
+    jobs = [(law, cell, group, s) for law in LAWS for cell in keys for group, seeds in groups.items() for s in seeds]
     results = run_many([Scenario(law, t, payload=g * 1e-3, orientation=Orientation(o), plant="as-built", seed=s)
-                        for law, (t, g, o), s in jobs])
+                        for law, (t, g, o), _, s in jobs])
     rmse: dict[tuple, list[float]] = {}
     moves: dict[tuple, list[dict]] = {}
-    for (law, cell, s), r in zip(jobs, results, strict=True):
-        group = next(name for name, group in seeds.items() if s in group)
+    for (law, cell, group, _), r in zip(jobs, results, strict=True):
         rmse.setdefault((law, cell, group), []).append(math.degrees(r.metrics.rmse))
-        if cell[0] == 1 and s in SEEDS:
-            t = r.trace.time
-            inside = t < MOVE
-            opened = r.trace.valve_open[:, 1] | r.trace.valve_open[:, 3]
-            moves.setdefault((law, cell), []).append(pulse_statistics(
-                t[inside], r.trace.desired_angle[inside], r.scored_angle[inside], opened[inside]))
-            squared = np.square(r.scored_angle - r.trace.desired_angle)
-            moves[(law, cell)][-1]["rms_deg"] = math.degrees(float(np.sqrt(np.mean(squared[inside]))))
-            moves[(law, cell)][-1]["share"] = float(squared[inside].sum() / squared.sum())
+        if cell[0] == 1 and group == "seeds 0-4":
+            moves.setdefault((law, cell), []).append(move_statistics(r, move_end))
 
-    def twin(law: str, cell: tuple, group: str) -> tuple[float, float]:
+    def twin_mean(law: str, cell: tuple, group: str) -> tuple[float, float]:
         values = rmse[(law, cell, group)]
         return float(np.mean(values)), float(np.std(values, ddof=1) / math.sqrt(len(values)))
 
-    def rig(law: str, cell: tuple) -> tuple[float, float]:
+    def rig_mean(law: str, cell: tuple) -> tuple[float, float]:
         target = TARGET_OF[(law, *cell)]
         return target.rmse_deg, target.rmse_std_deg / math.sqrt(THESIS_RUNS)
 
-    fresh = list(seeds)[1]
+    def leads(cell: tuple) -> tuple[tuple[float, float], ...]:
+        return (lead(rig_mean("smc", cell), rig_mean("ffpva", cell)),
+                *(lead(twin_mean("smc", cell, group), twin_mean("ffpva", cell, group)) for group in groups))
+
     print(f"preset {preset_digest(CALIBRATION_FILE)}: sliding mode's mean RMSE over FF + PVA's (the lead; below 1 "
           f"sliding mode ahead), on the {len(keys)} cells both were measured on; ± a first-order standard error; "
-          f"the reading on {fresh} (weaker: the twin's lead above the rig's by over {TIE:g} combined standard errors)")
-    print(f"  {'cell':22} {'rig':>13} {'twin, seeds 0-4':>16} {'twin, ' + fresh:>16}  reading;  sliding mode / "
+          f"the reading on {fresh} (weaker: the twin's lead above the rig's by over {TIE:g} combined standard errors; "
+          "z: by how many)")
+    print(f"  {'cell':22} {'rig':>13} {'twin, seeds 0-4':>16} {'twin, ' + fresh:>16}  reading (z);  sliding mode / "
           "FF + PVA RMSE: rig, twin on the fresh seeds (deg)")
-    said = []
+    said, shortfall = {}, {}
     for cell in keys:
-        rig_lead = lead(rig("smc", cell), rig("ffpva", cell))
-        first = lead(twin("smc", cell, "seeds 0-4"), twin("ffpva", cell, "seeds 0-4"))
-        second = lead(twin("smc", cell, fresh), twin("ffpva", cell, fresh))
-        said.append(reading(second, rig_lead))
+        rig_lead, first, second = leads(cell)
+        said[cell] = against_rig(second, rig_lead)
+        shortfall[cell] = second[0] / rig_lead[0]
         print(f"  {label(cell):22} {rig_lead[0]:6.2f} ± {rig_lead[1]:.2f} {first[0]:9.2f} ± {first[1]:.2f} "
-              f"{second[0]:9.2f} ± {second[1]:.2f}  {said[-1]};  {rig('smc', cell)[0]:.2f} / {rig('ffpva', cell)[0]:.2f}"
-              f", {twin('smc', cell, fresh)[0]:.2f} / {twin('ffpva', cell, fresh)[0]:.2f}")
-    shortfall = [lead(twin("smc", c, fresh), twin("ffpva", c, fresh))[0] / lead(rig("smc", c), rig("ffpva", c))[0]
-                 for c in keys]
-    print(f"the twin's lead over the rig's: x{min(shortfall):.2f}-x{max(shortfall):.2f} (median x"
-          f"{np.median(shortfall):.2f}); weaker on {said.count('weaker')} of {len(keys)}, stronger on "
-          f"{said.count('stronger')}, not told apart on {said.count('not told apart')}; the twin's lead smaller than "
-          f"the rig's on {sum(s > 1 for s in shortfall)} of {len(keys)}")
-    print(f"T1's move (its first {MOVE:g} s), seeds 0-4: per law, the RMS error over it (and its share of the run's "
+              f"{second[0]:9.2f} ± {second[1]:.2f}  {said[cell][0]} ({said[cell][1]:+.2f});  "
+              f"{rig_mean('smc', cell)[0]:.2f} / {rig_mean('ffpva', cell)[0]:.2f}, "
+              f"{twin_mean('smc', cell, fresh)[0]:.2f} / {twin_mean('ffpva', cell, fresh)[0]:.2f}")
+    readings = [r for r, _ in said.values()]
+    ratios = list(shortfall.values())
+    print(f"the twin's lead over the rig's: x{min(ratios):.2f}-x{max(ratios):.2f} (median x{np.median(ratios):.2f}); "
+          f"weaker on {readings.count('weaker')} of {len(keys)}, stronger on {readings.count('stronger')}, not told "
+          f"apart on {readings.count('not told apart')}; the twin's lead smaller than the rig's on "
+          f"{sum(r > 1 for r in ratios)} of {len(keys)}")
+    print(f"T1's move (its first {move_end:g} s), seeds 0-4: per law, the RMS error over it (and its share of the run's "
           "squared error, mean over the runs), discharge-valve openings per s, and per opening (medians) the error "
-          "when it opened and the advance until the next (deg)")
-    for cell in keys:
-        if cell[0] != 1:
-            continue
-        parts = []
+          "when it opened and the advance until the next (deg); then sliding mode's error at opening less FF + PVA's, "
+          "beside the twin's lead over the rig's")
+    for cell in (c for c in keys if c[0] == 1):
+        parts, at_opening = [], []
         for law in LAWS:
             stats = moves[(law, cell)]
-            parts.append(f"{'FF + PVA' if law == 'ffpva' else 'sliding mode'} RMS {np.mean([s['rms_deg'] for s in stats]):.2f}"
-                         f" ({np.mean([s['share'] for s in stats]):.0%} of the run's squared error), "
-                         f"{np.mean([s['openings_per_s'] for s in stats]):.1f}/s, error at opening "
-                         f"{np.median(np.concatenate([s['error_at_opening_deg'] for s in stats])):.2f}, advance "
-                         f"{np.median(np.concatenate([s['advance_deg'] for s in stats])):.2f}")
-        print(f"  {label(cell):22} " + "; ".join(parts))
+            at_opening.append(float(np.median(np.concatenate([s["error_at_opening_deg"] for s in stats]))))
+            parts.append(f"{CONTROLLER_LABELS[law]} RMS {np.mean([s['rms_deg'] for s in stats]):.2f} "
+                         f"({np.mean([s['share'] for s in stats]):.0%} of the run's squared error), "
+                         f"{np.mean([s['openings_per_s'] for s in stats]):.1f}/s, error at opening {at_opening[-1]:.2f}, "
+                         f"advance {np.median(np.concatenate([s['advance_deg'] for s in stats])):.2f}")
+        print(f"  {label(cell):22} " + "; ".join(parts)
+              + f"; gap {at_opening[1] - at_opening[0]:+.2f}, lead x{shortfall[cell]:.2f} the rig's")
 
 
 if __name__ == "__main__":

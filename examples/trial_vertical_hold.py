@@ -22,6 +22,7 @@ import pathlib
 import numpy as np
 
 from twin.envs.runner import run_many
+from twin.experiments.validate import discharge_open
 from twin.physics.model import Orientation
 from twin.plants.as_built import as_built_plant
 from twin.sim.scenario import Scenario
@@ -50,7 +51,7 @@ def main() -> None:
                 return float(np.sqrt(np.mean(error[:, mask] ** 2)))
 
             rmse = np.mean([math.degrees(r.metrics.rmse) for r in runs])
-            last = [int(np.flatnonzero(r.trace.valve_open[:, 1] | r.trace.valve_open[:, 3])[-1]) for r in runs]
+            last = [int(np.flatnonzero(discharge_open(r.trace.valve_open))[-1]) for r in runs]
             after = [math.degrees((r.trace.rack_position[-1] - r.trace.rack_position[k]) / radius)
                      for r, k in zip(runs, last, strict=True)]
             print(f"{label:12s} {orientation.value:12s} {rmse:5.2f}  {rms(t >= 1.0):5.2f}  "

@@ -1203,3 +1203,9 @@ def test_the_prediction_section_says_the_start_pressure_was_not_fitted_on_a_file
     assert "and with both chambers starting at 50 % of the supply, not fitted." in text
     assert "The band does not include the uncertainty of any of them" in text
     assert "(T3's length and start, the supply, where T1, T2 and T4 started, what the chambers held when a run began)" in text
+
+
+def test_discharge_open_is_either_discharge_valve():
+    """V2 or V4 (columns 1 and 3 of a trace's V1..V4), not the supply valves."""
+    valve_open = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1], [1, 1, 1, 1], [0, 0, 0, 0]], bool)
+    assert validate.discharge_open(valve_open).tolist() == [False, True, False, True, True, False]

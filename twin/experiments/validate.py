@@ -640,6 +640,11 @@ def ramp_opening_lags(plant, nominal, laws: dict) -> dict:
             "feedforward_pct": (float(u_ff.min()), float(u_ff.max()))}
 
 
+def discharge_open(valve_open: np.ndarray) -> np.ndarray:
+    """(T,) bool: either discharge valve open (V2 or V4), from a trace's ``valve_open`` (T, 4), V1..V4."""
+    return valve_open[:, 1] | valve_open[:, 3]
+
+
 def opening_starts(discharge_open: np.ndarray) -> np.ndarray:
     """Indices at which ``discharge_open`` (T,) bool turns true: where a discharge valve opens."""
     return np.flatnonzero(np.diff(np.concatenate(([False], discharge_open)).astype(int)) == 1)
@@ -690,7 +695,7 @@ def pulse_cycle(committed: dict[str, float]) -> dict:
     for k, key in enumerate(keys):
         runs = results[k * len(SEEDS):(k + 1) * len(SEEDS)]
         scored = [r.scored_angle for r in runs]
-        opened = [r.trace.valve_open[:, 1] | r.trace.valve_open[:, 3] for r in runs]
+        opened = [discharge_open(r.trace.valve_open) for r in runs]
         stats = [pulse_statistics(r.trace.time, r.trace.desired_angle, y, o)
                  for r, y, o in zip(runs, scored, opened, strict=True)]
         if key[1] == 2:
