@@ -233,7 +233,8 @@ def split_test(sets: list[dict], t3: dict[str, list[float]], noise: float, seed_
                 f"    {CONTROLLER_LABELS[controller]:12} {payload:4g} g {orientation:10}: lowest {min(lows):.2f}-"
                 f"{max(lows):.2f} (moves {max(lows) - min(lows):.2f}), highest {min(highs):.2f}-{max(highs):.2f} "
                 f"(moves {max(highs) - min(highs):.2f}) over the draws, the registered band {bands[i]:.2f} wide; the "
-                f"highest is {top}'s in {times} of {len(spans)}; without it {min(without):.2f}-{max(without):.2f}")
+                f"highest is {top}'s in {times} of {len(spans)}; without it "
+                + (f"{min(without):.2f}-{max(without):.2f}" if without else "no set is kept"))
         lines.append(f"    moving more than the registered band is wide: the highest in {wider['highest']} of "
                      f"{len(PREDICTION_CELLS)} cells, the lowest in {wider['lowest']}")
     return lines

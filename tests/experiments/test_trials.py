@@ -2016,6 +2016,19 @@ def test_the_docs_quote_the_band_trials_split():
             f"stalls, and {ff[12]}-{ff[13]} / {smc[12]}-{smc[13]} without it") in prediction
 
 
+def test_the_band_trials_split_says_so_when_only_the_highest_set_is_ever_kept():
+    """A set far below the rest is every draw's reference and its only kept set: no range without it, said in words."""
+    trial = _load("trial_band_on_fresh_seeds")
+    sets = [{"set": "low", "fresh_costs": [0.1, 0.11, 0.12, 0.1]}, {"set": "high", "fresh_costs": [2.0, 2.1, 2.2, 2.0]}]
+    t3 = {"low": [1.0] * 12, "high": [2.0] * 12}
+    lines = trial.split_test(sets, t3, 0.1, [[40], [41], [42], [43]], [0.5] * 12)
+    cells = [line for line in lines if line.startswith("    ") and " g " in line]
+    assert len(cells) == 24  # four seed sets: draws of two (six draws) and of one (four); none of four
+    assert all(line.endswith(f"the highest is low's in {n} of {n}; without it no set is kept")
+               for line, n in zip(cells, [6] * 12 + [4] * 12, strict=True))
+    assert "of the 2, 1 kept in every draw, 1 in none, 0 in some" in lines[0]
+
+
 def test_the_band_trials_draws_pair_each_two_disjoint_draws_once():
     trial = _load("trial_band_on_fresh_seeds")
     assert trial.draws(4, 2) == [((0, 1), (2, 3)), ((0, 2), (1, 3)), ((0, 3), (1, 2))]
