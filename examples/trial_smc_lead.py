@@ -21,7 +21,8 @@ were measured on (§8's T1-T4 and §9's five T1 payload cells), on the rig and i
 
 Written 2026-12-06 (stop 51), after seeing the leads that ``twin whatif smc-phi`` prints on seeds 0-9 and T1's move
 in pulses on seeds 0-4 in a scratch script; the reading and the table were written before this script first ran
-(the move's share of the squared error was added after, to quote it rather than the scratch script's). No
+(the move's share of the squared error was added after, to quote it rather than the scratch script's; each
+reading's z, and each T1 cell's gap between the laws' errors at opening beside its lead, after a review). No
 T3 cell is run; nothing is fitted or installed. Its output is kept as ``examples/trial_smc_lead/lead.txt`` (about
 50 s on 2 cores).
 
