@@ -4,7 +4,8 @@ file names a path.
 ``examples/trial_profile_likelihood.py`` writes them; it (``--check``), ``trial_profile_orders.py`` and
 ``trial_fresh_seed_costs.py`` read them through :func:`read`, so the three refuse a file that is not one in the same
 words. The trials that read them also take from here the T3 cells' rows (:func:`t3_rows`) and the key that makes two
-kept rows one set (:func:`set_key`). A trial loads this module from its own folder (``sys.path``), however the trial itself is loaded.
+kept rows one set (:func:`set_key`). A trial loads this module from its own folder (``sys.path``), however the trial
+itself is loaded.
 """
 
 from __future__ import annotations

@@ -182,12 +182,16 @@ def draws(count: int, size: int) -> list[tuple[tuple[int, ...], tuple[int, ...]]
 def rerank(sets: list[dict], draw: tuple[int, ...], noise: float) -> tuple[dict, list[dict]]:
     """The design "re-rank the candidates on fresh seeds", on the seed sets ``draw`` alone: the reference (the set
     with the lowest mean cost there) and the sets whose reading against it there is not worse, by :func:`against`'s
-    rule (the reference among them). On one seed set, where a paired difference has no standard error, the fit's cut
-    instead: a mean within the reference's plus the noise (the fit's cap of 13 members left out)."""
+    rule (the reference among them). On one seed set, where a paired difference has no standard error, the fit's own
+    choice instead (``calibrate.choose_ensemble``: a cost within the reference's plus the noise), its cap of 13
+    members lifted."""
     on = [{**s, "fresh_costs": [s["fresh_costs"][i] for i in draw]} for s in sets]
     reference = min(on, key=lambda s: float(np.mean(s["fresh_costs"])))
     if len(draw) == 1:
-        kept = [s for s in on if s["fresh_costs"][0] <= reference["fresh_costs"][0] + noise]
+        evaluations = [calibrate.Evaluation(s["values"], s["fresh_costs"][0], "fresh") for s in on]
+        chosen = {id(e) for e in calibrate.choose_ensemble(evaluations, evaluations[on.index(reference)], noise,
+                                                           limit=len(on))}
+        kept = [s for s, e in zip(on, evaluations, strict=True) if id(e) in chosen]
     else:
         kept = against(on, reference, noise)
     return reference, kept

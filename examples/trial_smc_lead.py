@@ -37,11 +37,12 @@ import numpy as np
 
 from twin.envs.runner import run_many
 from twin.experiments.calibrate import TARGET_OF, TARGETS, THESIS_RUNS
-from twin.experiments.validate import FRESH_SEEDS, SEEDS, discharge_open, pulse_statistics
+from twin.experiments.validate import FRESH_SEEDS, SEEDS, discharge_open, pulse_statistics, ratio_se
 from twin.physics.model import Orientation
 from twin.physics.trajectories import trajectory
 from twin.plants import plant
 from twin.plants.as_built import CALIBRATION_FILE, preset_digest
+from twin.sim.metrics import spread
 from twin.sim.scenario import CONTROLLER_LABELS, Scenario
 
 LAWS = ("ffpva", "smc")
@@ -55,10 +56,9 @@ def cells() -> list[tuple[int, float, str]]:
 
 
 def lead(smc: tuple[float, float], ffpva: tuple[float, float]) -> tuple[float, float]:
-    """Sliding mode's mean over FF + PVA's, and the ratio's first-order standard error, from each law's (mean,
-    standard error of the mean)."""
-    ratio = smc[0] / ffpva[0]
-    return ratio, ratio * math.hypot(smc[1] / smc[0], ffpva[1] / ffpva[0])
+    """Sliding mode's mean over FF + PVA's, and the ratio's first-order standard error (``validate.ratio_se``, as
+    the report's payload costs take it), from each law's (mean, standard error of the mean)."""
+    return ratio_se(*smc, *ffpva)
 
 
 def against_rig(twin_lead: tuple[float, float], rig_lead: tuple[float, float]) -> tuple[str, float]:
@@ -102,8 +102,8 @@ def main() -> None:
             moves.setdefault((law, cell), []).append(move_statistics(r, move_end))
 
     def twin_mean(law: str, cell: tuple, group: str) -> tuple[float, float]:
-        values = rmse[(law, cell, group)]
-        return float(np.mean(values)), float(np.std(values, ddof=1) / math.sqrt(len(values)))
+        runs = spread(rmse[(law, cell, group)])
+        return runs.mean, runs.std / math.sqrt(runs.n)
 
     def rig_mean(law: str, cell: tuple) -> tuple[float, float]:
         target = TARGET_OF[(law, *cell)]

@@ -2018,8 +2018,12 @@ def test_the_docs_quote_the_band_trials_split():
 
 def test_the_band_trials_split_says_so_when_only_the_highest_set_is_ever_kept():
     """A set far below the rest is every draw's reference and its only kept set: no range without it, said in words."""
+    from twin.plants.as_built import CALIBRATION_FILE, ensemble_values
+
     trial = _load("trial_band_on_fresh_seeds")
-    sets = [{"set": "low", "fresh_costs": [0.1, 0.11, 0.12, 0.1]}, {"set": "high", "fresh_costs": [2.0, 2.1, 2.2, 2.0]}]
+    low, high = ensemble_values(CALIBRATION_FILE)[:2]  # two parameter sets the fit's own choice can tell apart
+    sets = [{"set": "low", "values": low, "fresh_costs": [0.1, 0.11, 0.12, 0.1]},
+            {"set": "high", "values": high, "fresh_costs": [2.0, 2.1, 2.2, 2.0]}]
     t3 = {"low": [1.0] * 12, "high": [2.0] * 12}
     lines = trial.split_test(sets, t3, 0.1, [[40], [41], [42], [43]], [0.5] * 12)
     cells = [line for line in lines if line.startswith("    ") and " g " in line]

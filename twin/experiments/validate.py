@@ -337,7 +337,7 @@ def max_error_rows(five: Sequence[calibrate.CellResult], fresh: Sequence[calibra
     return rows
 
 
-def _ratio_se(top: float, top_se: float, bottom: float, bottom_se: float) -> tuple[float, float]:
+def ratio_se(top: float, top_se: float, bottom: float, bottom_se: float) -> tuple[float, float]:
     """top / bottom and its standard error, the two taken as independent."""
     ratio = top / bottom
     return ratio, ratio * math.hypot(top_se / top, bottom_se / bottom)
@@ -357,8 +357,8 @@ def payload_effects(seeds: Sequence[dict]) -> list[dict]:
         if r["trajectory"] != 1 or b is None or r is b:
             continue
         runs, base_runs = r["runs"], b["runs"]
-        measured, measured_se = _ratio_se(r["measured"], r["measured_se"], b["measured"], b["measured_se"])
-        twin, twin_se = _ratio_se(r["twin_mean"], r["twin_std"] / math.sqrt(runs), b["twin_mean"],
+        measured, measured_se = ratio_se(r["measured"], r["measured_se"], b["measured"], b["measured_se"])
+        twin, twin_se = ratio_se(r["twin_mean"], r["twin_std"] / math.sqrt(runs), b["twin_mean"],
                                   b["twin_std"] / math.sqrt(base_runs))
         rows.append({"controller": r["controller"], "payload_g": r["payload_g"], "orientation": r["orientation"],
                      "measured_effect": measured, "measured_se": measured_se, "twin_effect": twin, "twin_se": twin_se,
@@ -645,21 +645,20 @@ def discharge_open(valve_open: np.ndarray) -> np.ndarray:
     return valve_open[:, 1] | valve_open[:, 3]
 
 
-def opening_starts(discharge_open: np.ndarray) -> np.ndarray:
-    """Indices at which ``discharge_open`` (T,) bool turns true: where a discharge valve opens."""
-    return np.flatnonzero(np.diff(np.concatenate(([False], discharge_open)).astype(int)) == 1)
+def opening_starts(opened: np.ndarray) -> np.ndarray:
+    """Indices at which ``opened`` (T,) bool turns true: where a discharge valve opens (:func:`discharge_open`)."""
+    return np.flatnonzero(np.diff(np.concatenate(([False], opened)).astype(int)) == 1)
 
 
-def pulse_statistics(time: np.ndarray, desired: np.ndarray, scored: np.ndarray, discharge_open: np.ndarray
-                     ) -> dict:
-    """One run's pulses: ``discharge_open`` (T,) bool, either discharge valve open; angles in rad. Returns the
-    openings per second, and per opening the advance of the scored angle until the next opening (or the
-    run's end) and the error |desired - scored| when the valve opened, each as a list in deg."""
-    opened = opening_starts(discharge_open)
-    ends = np.append(opened[1:], len(time) - 1)
-    return {"openings_per_s": len(opened) / (time[-1] - time[0] + (time[1] - time[0])),
-            "advance_deg": [math.degrees(abs(scored[b] - scored[a])) for a, b in zip(opened, ends, strict=True)],
-            "error_at_opening_deg": [math.degrees(abs(desired[a] - scored[a])) for a in opened]}
+def pulse_statistics(time: np.ndarray, desired: np.ndarray, scored: np.ndarray, opened: np.ndarray) -> dict:
+    """One run's pulses: ``opened`` (T,) bool, either discharge valve open (:func:`discharge_open`); angles in rad.
+    Returns the openings per second, and per opening the advance of the scored angle until the next opening (or
+    the run's end) and the error |desired - scored| when the valve opened, each as a list in deg."""
+    starts = opening_starts(opened)
+    ends = np.append(starts[1:], len(time) - 1)
+    return {"openings_per_s": len(starts) / (time[-1] - time[0] + (time[1] - time[0])),
+            "advance_deg": [math.degrees(abs(scored[b] - scored[a])) for a, b in zip(starts, ends, strict=True)],
+            "error_at_opening_deg": [math.degrees(abs(desired[a] - scored[a])) for a in starts]}
 
 
 def pulse_cycle(committed: dict[str, float]) -> dict:
