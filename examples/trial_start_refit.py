@@ -77,6 +77,9 @@ from twin.plants.as_built import (
 )
 from twin.sim.scenario import Scenario
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling modules, however this one is loaded
+import kept_profiles  # noqa: E402
+
 COMMITTED_START_DEG = 30.0
 UNFITTED_STARTS_DEG = (20.0, 24.0, 30.0, 40.0, 50.0, 54.0)  # 54 + 120 = 174 deg, the Coulomb fit's top
 
@@ -179,7 +182,7 @@ def from_committed(data: dict, workers: int) -> None:
     committed = calibrated_values(ELEVENTH_REFIT_FILE)
     print(f"its members from {COMMITTED_START_DEG:g} deg, fit seeds, against the eleventh refit's cut {best + noise:.4f} "
           f"(cost {best:.4f} + noise {noise:.4f}; preset {preset_digest(ELEVENTH_REFIT_FILE)}):")
-    rows = [{"controller": law, "payload_g": g, "orientation": o} for law, _, g, o in PREDICTION_CELLS]
+    rows = kept_profiles.t3_rows()
     with calibrate.Evaluator(seeds=calibrate.FIT_SEEDS, workers=workers) as evaluator:
         further = None
         for index, member in enumerate(data["ensemble"]):

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+import os
+import platform
+import subprocess
+import sys
+
 import mujoco
 import numpy as np
 import pytest
@@ -93,3 +98,42 @@ def test_referred_mass_closed_form_is_the_multibody_inertia_along_the_rack():
         + (1.095e-8 + 2.45e-7) / (9.525e-3 / 2) ** 2
     assert referred_mass(params) == pytest.approx(expected, rel=1e-3)
     assert compile_joint(params=params).effective_mass == pytest.approx(referred_mass(params), rel=1e-9)
+
+
+# T1 0 g vertical's compiled rack-side manifold and joint-space inertia diagonal, to the last bit (2026-12-06)
+VERTICAL_MANIFOLD = [float.fromhex(x) for x in (
+    "0x1.0000000000000p+0", "-0x1.0000000000000p+0", "-0x1.0d8ab206e6781p+9", "0x1.a3f28fca3f28fp+7")]
+VERTICAL_DIAGONAL = [float.fromhex(x) for x in (
+    "0x1.06cca2db61bb0p-6", "0x1.06cca2db61bb0p-6", "0x1.07e1fe91b0b71p-31", "0x1.12d30012807d7p-22")]
+VERTICAL_MASS = float.fromhex("0x1.6462a4203bb6fp-5")  # what every kept result ran on
+
+
+def test_the_effective_mass_is_one_rounding_sequence_within_its_closed_form():
+    """diagonal_form is the exact v' D v to a few roundings, and the sequence is the fused one: on these inputs a
+    plain sum in the same order lands one bit lower (0x1.6462a4203bb6ep-5), which is what OpenBLAS's Haswell kernel
+    gave and why kept results failed to rerun to the last bit on a machine that picks it."""
+    from fractions import Fraction
+
+    from twin.physics.model import diagonal_form
+
+    v, d = np.array(VERTICAL_MANIFOLD), np.array(VERTICAL_DIAGONAL)
+    exact = sum(Fraction(a) * Fraction(a) * Fraction(b) for a, b in zip(v.tolist(), d.tolist(), strict=True))
+    mass = diagonal_form(v, d)
+    assert abs(Fraction(mass) - exact) <= 4 * Fraction(np.spacing(mass))
+    plain = 0.0
+    for a, b in zip(v.tolist(), d.tolist(), strict=True):
+        plain += (a * b) * a
+    assert plain == float.fromhex("0x1.6462a4203bb6ep-5") != mass == VERTICAL_MASS
+
+
+def test_the_effective_mass_does_not_turn_on_the_blas_kernel():
+    """Compiled in a new interpreter with OpenBLAS held to its Haswell kernel (which sums a dot product by plain adds),
+    0 g vertical's effective mass is still the bit every kept result ran on. Before diagonal_form it came out one bit
+    lower there, and 20 kept-result reruns failed on a machine whose OpenBLAS picks that kernel."""
+    if platform.machine() not in ("x86_64", "AMD64"):
+        pytest.skip("OpenBLAS's Haswell kernel is an x86-64 one")
+    code = ("from twin.physics.model import Orientation, compile_joint; "
+            "print(compile_joint(orientation=Orientation.VERTICAL).effective_mass.hex())")
+    env = dict(os.environ, OPENBLAS_CORETYPE="Haswell")
+    out = subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True, check=True).stdout
+    assert float.fromhex(out.strip()) == VERTICAL_MASS
