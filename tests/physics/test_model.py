@@ -6,13 +6,21 @@ import os
 import platform
 import subprocess
 import sys
+from fractions import Fraction
 
 import mujoco
 import numpy as np
 import pytest
 
 from twin.exceptions import InvalidScenario
-from twin.physics.model import MODEL_PATH, Orientation, compile_joint, referred_mass
+from twin.physics.model import (
+    MODEL_PATH,
+    Orientation,
+    _joint_space_inertia,
+    compile_joint,
+    diagonal_form,
+    referred_mass,
+)
 from twin.physics.params import JointParams
 
 OBJECTS = [mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_GEOM, mujoco.mjtObj.mjOBJ_SITE,
@@ -106,30 +114,32 @@ VERTICAL_MANIFOLD = [float.fromhex(x) for x in (
 VERTICAL_DIAGONAL = [float.fromhex(x) for x in (
     "0x1.06cca2db61bb0p-6", "0x1.06cca2db61bb0p-6", "0x1.07e1fe91b0b71p-31", "0x1.12d30012807d7p-22")]
 VERTICAL_MASS = float.fromhex("0x1.6462a4203bb6fp-5")  # what every kept result ran on
+VERTICAL_MASS_PLAIN_ADDS = float.fromhex("0x1.6462a4203bb6ep-5")  # OpenBLAS's Haswell kernel's manifold @ M @ manifold
 
 
 def test_the_effective_mass_is_one_rounding_sequence_within_its_closed_form():
-    """diagonal_form is the exact v' D v to a few roundings, and the sequence is the fused one: on these inputs a
-    plain sum in the same order lands one bit lower (0x1.6462a4203bb6ep-5), which is what OpenBLAS's Haswell kernel
-    gave and why kept results failed to rerun to the last bit on a machine that picks it."""
-    from fractions import Fraction
-
-    from twin.physics.model import diagonal_form
-
+    """0 g vertical's compiled inputs are the ones below; diagonal_form of them is the exact v' D v within the
+    rounding bound of four positive terms (5 u of the sum), and it is the fused sequence: a plain sum in the same
+    order lands one bit lower, which is what OpenBLAS's Haswell kernel gave (the plain sum is the nearer to the exact
+    value, so only this equality tells the two sequences apart)."""
+    joint = compile_joint(orientation=Orientation.VERTICAL)
+    assert joint.manifold.tolist() == VERTICAL_MANIFOLD
+    assert np.diag(_joint_space_inertia(joint.model)).tolist() == VERTICAL_DIAGONAL
     v, d = np.array(VERTICAL_MANIFOLD), np.array(VERTICAL_DIAGONAL)
     exact = sum(Fraction(a) * Fraction(a) * Fraction(b) for a, b in zip(v.tolist(), d.tolist(), strict=True))
     mass = diagonal_form(v, d)
-    assert abs(Fraction(mass) - exact) <= 4 * Fraction(np.spacing(mass))
+    assert abs(Fraction(mass) - exact) <= 5 * Fraction(1, 2**53) * exact
     plain = 0.0
     for a, b in zip(v.tolist(), d.tolist(), strict=True):
         plain += (a * b) * a
-    assert plain == float.fromhex("0x1.6462a4203bb6ep-5") != mass == VERTICAL_MASS
+    assert plain == VERTICAL_MASS_PLAIN_ADDS != mass == VERTICAL_MASS == joint.effective_mass
 
 
 def test_the_effective_mass_does_not_turn_on_the_blas_kernel():
-    """Compiled in a new interpreter with OpenBLAS held to its Haswell kernel (which sums a dot product by plain adds),
-    0 g vertical's effective mass is still the bit every kept result ran on. Before diagonal_form it came out one bit
-    lower there, and 20 kept-result reruns failed on a machine whose OpenBLAS picks that kernel."""
+    """Compiled in a new interpreter with OpenBLAS held to its Haswell kernel, 0 g vertical's effective mass is still
+    the bit every kept result ran on. Before diagonal_form it came out one bit lower there, and 20 kept-result reruns
+    failed in a shell that set OPENBLAS_CORETYPE=Haswell. A BLAS that does not read that variable (one built without
+    run-time kernel choice, or not OpenBLAS) passes this trivially."""
     if platform.machine() not in ("x86_64", "AMD64"):
         pytest.skip("OpenBLAS's Haswell kernel is an x86-64 one")
     code = ("from twin.physics.model import Orientation, compile_joint; "

@@ -163,18 +163,14 @@ def referred_mass(params: JointParams = NOMINAL_PARAMS) -> float:
 
 
 def diagonal_form(vector: np.ndarray, diagonal: np.ndarray) -> float:
-    """``vector @ diag(diagonal) @ vector`` by one fixed sequence of roundings, the same on every machine: each
+    """``vector @ diag(diagonal) @ vector`` by one fixed sequence of roundings, whatever BLAS is loaded: each
     ``vector[i] * diagonal[i]`` rounded, then summed by fused multiply-adds with ``vector[i]`` in index order, each
-    rounded once (exact rationals stand in for the fused multiply-add, which Python has only from 3.13).
-
-    The effective mass was ``manifold @ inertia @ manifold``, which numpy hands to OpenBLAS, and OpenBLAS picks its
-    kernel by the CPU: its SkylakeX kernel sums by fused multiply-adds in this order, its Haswell kernel (taken on
-    some AVX-512 AMD machines) by plain adds, and the two differ in the last bit for some payloads (0 g vertical
-    among them), which every later step then carries. This is the SkylakeX kernel's sequence, the one every kept
-    result was run on (equal on 202 payloads from 0 to 50 g, both orientations, checked 2026-12-06)."""
+    rounded once (exact rationals stand in for the fused multiply-add, which Python has only from 3.13). It is the
+    sequence OpenBLAS's SkylakeX kernel gave the effective mass when it was ``manifold @ inertia @ manifold``, on
+    which every kept result ran; its Haswell kernel gives another last bit (docs/testing.md)."""
     total = 0.0
     for v, d in zip(vector.tolist(), diagonal.tolist(), strict=True):
-        total = float(fractions.Fraction(float(v * d)) * fractions.Fraction(v) + fractions.Fraction(total))
+        total = float(fractions.Fraction(v * d) * fractions.Fraction(v) + fractions.Fraction(total))
     return total
 
 
