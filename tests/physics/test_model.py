@@ -118,19 +118,19 @@ VERTICAL_MASS_PLAIN_ADDS = float.fromhex("0x1.6462a4203bb6ep-5")  # OpenBLAS's H
 
 
 def test_the_effective_mass_is_one_rounding_sequence_within_its_closed_form():
-    """0 g vertical's compiled inputs are the ones below; diagonal_form of them is the exact v' D v within the
+    """0 g vertical's compiled inputs are the ones pinned above; diagonal_form of them is the exact v' D v within the
     rounding bound of four positive terms (5 u of the sum), and it is the fused sequence: a plain sum in the same
     order lands one bit lower, which is what OpenBLAS's Haswell kernel gave (the plain sum is the nearer to the exact
     value, so only this equality tells the two sequences apart)."""
     joint = compile_joint(orientation=Orientation.VERTICAL)
     assert joint.manifold.tolist() == VERTICAL_MANIFOLD
     assert np.diag(_joint_space_inertia(joint.model)).tolist() == VERTICAL_DIAGONAL
-    v, d = np.array(VERTICAL_MANIFOLD), np.array(VERTICAL_DIAGONAL)
-    exact = sum(Fraction(a) * Fraction(a) * Fraction(b) for a, b in zip(v.tolist(), d.tolist(), strict=True))
-    mass = diagonal_form(v, d)
+    pairs = list(zip(VERTICAL_MANIFOLD, VERTICAL_DIAGONAL, strict=True))
+    exact = sum(Fraction(a) * Fraction(a) * Fraction(b) for a, b in pairs)
+    mass = diagonal_form(np.array(VERTICAL_MANIFOLD), np.array(VERTICAL_DIAGONAL))
     assert abs(Fraction(mass) - exact) <= 5 * Fraction(1, 2**53) * exact
     plain = 0.0
-    for a, b in zip(v.tolist(), d.tolist(), strict=True):
+    for a, b in pairs:
         plain += (a * b) * a
     assert plain == VERTICAL_MASS_PLAIN_ADDS != mass == VERTICAL_MASS == joint.effective_mass
 
