@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import dataclasses
 import math
+from fractions import Fraction
 
 import numpy as np
 import pytest
@@ -98,6 +99,27 @@ def test_flow_is_proportional_to_the_pressure_drop():
     resistance, intercept, flows = valve.replica(60.0)
     drops = np.array(RIG.pressure_drops)
     assert np.allclose(flows, drops / resistance, rtol=1e-9) and abs(intercept) < 1e-15
+
+
+def test_the_line_fit_gives_the_closed_form_least_squares_line_exactly():
+    # (0, 1), (1, 3), (2, 2): x mean 1, y mean 2, slope (-1 * -1 + 1 * 0) / 2 = 1/2, intercept 2 - 1/2 = 3/2
+    assert valve.line_fit([0.0, 1.0, 2.0], [1.0, 3.0, 2.0]) == (Fraction(1, 2), Fraction(3, 2))
+    # the rig's drops with flows exactly proportional to them (k a power of two): slope k, intercept 0, no rounding
+    k = 2.0 ** -40
+    assert valve.line_fit(RIG.pressure_drops, [k * d for d in RIG.pressure_drops]) == (Fraction(k), 0)
+
+
+def test_the_replica_fits_its_line_without_blas(monkeypatch):
+    """R(d) must not turn on which BLAS kernel numpy loads (see docs/testing.md): the fit calls neither of numpy's
+    least-squares routines, which go to it."""
+    def refused(*args, **kwargs):
+        raise AssertionError("a BLAS least-squares fit")
+
+    monkeypatch.setattr(np, "polyfit", refused)
+    monkeypatch.setattr(np.linalg, "lstsq", refused)
+    resistance, intercept, flows = valve.replica(60.0)
+    slope, _ = valve.line_fit(RIG.pressure_drops, flows)
+    assert resistance == float(1 / slope) and math.isfinite(resistance)
 
 
 def test_cli_writes_the_valve_table_and_plot(tmp_path):

@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import math
 import pathlib
+from fractions import Fraction
 
 import numpy as np
 
@@ -30,6 +31,17 @@ NOMINAL_SOLENOID = SolenoidParams()
 NOMINAL_RIG = ValveTestRigParams()
 
 
+def line_fit(x, y) -> tuple[Fraction, Fraction]:
+    """The least-squares line through the points (``x``, ``y``): its slope and intercept, exactly, in rational
+    arithmetic on the floats given. No BLAS kernel takes part (``np.polyfit`` went to OpenBLAS, whose kernels differ
+    in the last bits), so a value rounded from these is the same on every machine."""
+    xs, ys = [Fraction(float(v)) for v in x], [Fraction(float(v)) for v in y]
+    x_mean, y_mean = sum(xs) / len(xs), sum(ys) / len(ys)
+    slope = (sum((a - x_mean) * (b - y_mean) for a, b in zip(xs, ys, strict=True))
+             / sum((a - x_mean) ** 2 for a in xs))
+    return slope, y_mean - slope * x_mean
+
+
 def replica(duty: float, *, params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigParams = NOMINAL_RIG
             ) -> tuple[float, float, np.ndarray]:
     """(R in Pa s/m^3 from the slope, intercept in m^3/s, the mean flows (m^3/s) at each of the
@@ -41,8 +53,8 @@ def replica(duty: float, *, params: SolenoidParams = NOMINAL_SOLENOID, rig: Valv
     flows = fraction * drops / valves.open_resistance  # a linear valve: each drop simulated gives the same fraction
     if fraction <= 0.0:
         return math.inf, 0.0, flows
-    slope, intercept = np.polyfit(drops, flows, 1)
-    return float(1.0 / slope), float(intercept), flows
+    slope, intercept = line_fit(drops, flows)
+    return float(1 / slope), float(intercept), flows
 
 
 def emergent_dead_zone(params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigParams = NOMINAL_RIG
