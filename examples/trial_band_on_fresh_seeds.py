@@ -57,7 +57,6 @@ import argparse
 import collections
 import csv
 import itertools
-import json
 import math
 import pathlib
 import sys
@@ -71,7 +70,7 @@ from twin.sim.scenario import CONTROLLER_LABELS
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling modules, however this one is loaded
 import kept_profiles  # noqa: E402
-from trial_fresh_seed_costs import paired, reading  # noqa: E402
+from trial_fresh_seed_costs import paired, read_fresh, reading  # noqa: E402
 
 COSTS = kept_profiles.ROOT / "examples" / "trial_fresh_seed_costs" / "costs_40-119.json"
 REGISTERED = kept_profiles.ROOT / "twin" / "experiments" / "data"  # t3_prediction.csv, t3_prediction_members.csv
@@ -118,21 +117,13 @@ def kept_t3(parser: argparse.ArgumentParser) -> dict[str, tuple[dict[str, float]
 def read_costs(parser: argparse.ArgumentParser, path: pathlib.Path, digest: str) -> dict:
     """The kept fresh-seed run ``path``, or a one-line parser error: not such a complete run (on two or more seed
     sets, as a standard error needs) on the committed preset whose members are the committed file's."""
-    try:
-        kept = json.loads(pathlib.Path(path).read_text())
-    except (OSError, UnicodeDecodeError, ValueError) as error:
-        parser.error(f"--costs {path}: cannot read it as JSON ({error.__class__.__name__})")
-    if not (isinstance(kept, dict) and kept.get("complete") is True and isinstance(kept.get("sets"), list)
-            and kept["sets"] and isinstance(kept.get("fresh_seed_sets"), list) and len(kept["fresh_seed_sets"]) >= 2
-            and all(isinstance(seeds, list) and seeds and all(isinstance(x, int) for x in seeds)
-                    for seeds in kept["fresh_seed_sets"])
-            and isinstance(kept.get("noise"), float) and all(
-                isinstance(s, dict) and all(isinstance(s.get(k), kind) for k, kind in ROW.items())
-                and len(s["fresh_costs"]) == len(kept["fresh_seed_sets"])
-                and all(isinstance(c, float) and math.isfinite(c) for c in s["fresh_costs"]) for s in kept["sets"])):
-        parser.error(f"--costs {path}: not a complete kept fresh-seed trial file")
-    if kept.get("preset") != digest:
-        parser.error(f"--costs {path}: run on preset {kept.get('preset')}, not the committed {digest}")
+    kept = read_fresh(parser, "--costs", path, digest, more=lambda kept: bool(
+        kept["sets"] and len(kept["fresh_seed_sets"]) >= 2
+        and all(isinstance(seeds, list) and seeds and all(isinstance(x, int) for x in seeds)
+                for seeds in kept["fresh_seed_sets"])
+        and isinstance(kept.get("noise"), float) and all(
+            all(isinstance(s.get(k), kind) for k, kind in ROW.items())
+            and all(isinstance(c, float) and math.isfinite(c) for c in s["fresh_costs"]) for s in kept["sets"])))
     members = [s["values"] for s in kept["sets"] if s["set"].startswith("member ")]
     if members != ensemble_values(CALIBRATION_FILE):
         parser.error(f"--costs {path}: its members are not the committed file's")

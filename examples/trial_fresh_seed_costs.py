@@ -50,6 +50,7 @@ import math
 import pathlib
 import sys
 import time
+from collections.abc import Callable
 
 import numpy as np
 
@@ -123,21 +124,30 @@ def fresh_costs(evaluator: calibrate.Evaluator, values: dict[str, float], count:
     return list(known) + [calibrate.cost(evaluator.cells(values, seeds=seeds)) for seeds in seed_sets(count)[len(known):]]
 
 
-def reused(parser: argparse.ArgumentParser, path: pathlib.Path, digest: str, count: int) -> dict[str, dict]:
-    """The kept fresh-seed file ``path``'s sets by label (--reuse), or a one-line parser error: not such a file, run
-    on another preset, or on seed sets that are not the first of this run's."""
+def read_fresh(parser: argparse.ArgumentParser, flag: str, path: pathlib.Path, digest: str,
+               more: Callable[[dict], bool] = lambda kept: True) -> dict:
+    """The kept fresh-seed trial file ``path``, given as ``flag``, or a one-line parser error: not JSON, not a complete
+    such file (its sets' rows as this trial writes them, each with a cost per seed set, and whatever ``more`` asks of
+    it), or run on another preset than the committed ``digest``. The band trial reads the same files through it."""
     try:
         kept = json.loads(pathlib.Path(path).read_text())
     except (OSError, UnicodeDecodeError, ValueError) as error:
-        parser.error(f"--reuse {path}: cannot read it as JSON ({error.__class__.__name__})")
+        parser.error(f"{flag} {path}: cannot read it as JSON ({error.__class__.__name__})")
     if not (isinstance(kept, dict) and isinstance(kept.get("sets"), list) and kept.get("complete") is True
             and isinstance(kept.get("fresh_seed_sets"), list) and all(
                 isinstance(row, dict) and {"set", "values", "fresh_costs"} <= set(row)
                 and isinstance(row["fresh_costs"], list) and len(row["fresh_costs"]) == len(kept["fresh_seed_sets"])
-                for row in kept["sets"])):
-        parser.error(f"--reuse {path}: not a complete kept fresh-seed trial file")
+                for row in kept["sets"]) and more(kept)):
+        parser.error(f"{flag} {path}: not a complete kept fresh-seed trial file")
     if kept.get("preset") != digest:
-        parser.error(f"--reuse {path}: run on preset {kept.get('preset')}, not the committed {digest}")
+        parser.error(f"{flag} {path}: run on preset {kept.get('preset')}, not the committed {digest}")
+    return kept
+
+
+def reused(parser: argparse.ArgumentParser, path: pathlib.Path, digest: str, count: int) -> dict[str, dict]:
+    """The kept fresh-seed file ``path``'s sets by label (--reuse), or a one-line parser error: not such a file, run
+    on another preset, or on seed sets that are not the first of this run's."""
+    kept = read_fresh(parser, "--reuse", path, digest)
     held = kept["fresh_seed_sets"]
     if held != seed_sets(len(held)) or len(held) > count:
         parser.error(f"--reuse {path}: its seed sets are not the first of this run's {count}")
