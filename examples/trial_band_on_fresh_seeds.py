@@ -114,16 +114,22 @@ def kept_t3(parser: argparse.ArgumentParser) -> dict[str, tuple[dict[str, float]
     return found
 
 
+def has_band_inputs(kept: dict) -> bool:
+    """Whether a kept fresh-seed file (its shape checked by ``read_fresh``) holds what the band trial reads: some sets,
+    two or more seed sets of seeds (a standard error needs two), the noise, and each set's row whole with finite costs."""
+    return bool(kept["sets"] and len(kept["fresh_seed_sets"]) >= 2
+                and all(isinstance(seeds, list) and seeds and all(isinstance(x, int) for x in seeds)
+                        for seeds in kept["fresh_seed_sets"])
+                and isinstance(kept.get("noise"), float)
+                and all(all(isinstance(s.get(k), kind) for k, kind in ROW.items())
+                        and all(isinstance(c, float) and math.isfinite(c) for c in s["fresh_costs"])
+                        for s in kept["sets"]))
+
+
 def read_costs(parser: argparse.ArgumentParser, path: pathlib.Path, digest: str) -> dict:
     """The kept fresh-seed run ``path``, or a one-line parser error: not such a complete run (on two or more seed
     sets, as a standard error needs) on the committed preset whose members are the committed file's."""
-    kept = read_fresh(parser, "--costs", path, digest, more=lambda kept: bool(
-        kept["sets"] and len(kept["fresh_seed_sets"]) >= 2
-        and all(isinstance(seeds, list) and seeds and all(isinstance(x, int) for x in seeds)
-                for seeds in kept["fresh_seed_sets"])
-        and isinstance(kept.get("noise"), float) and all(
-            all(isinstance(s.get(k), kind) for k, kind in ROW.items())
-            and all(isinstance(c, float) and math.isfinite(c) for c in s["fresh_costs"]) for s in kept["sets"])))
+    kept = read_fresh(parser, "--costs", path, digest, more=has_band_inputs)
     members = [s["values"] for s in kept["sets"] if s["set"].startswith("member ")]
     if members != ensemble_values(CALIBRATION_FILE):
         parser.error(f"--costs {path}: its members are not the committed file's")
