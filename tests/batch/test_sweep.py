@@ -27,6 +27,19 @@ AXES = {"controller": ["ffpva", "smc"], "trajectory": [1, 2], "payload": [0.0, 1
         "orientation": ["vertical"], "seed": [0, 1, 2]}
 
 
+@pytest.fixture
+def one_ray_at_a_time():
+    """Tests that start a real Ray take turns, across pytest's worker processes and any other pytest of this user
+    on the machine: ``--ray-address auto`` joins whatever local Ray it finds (Ray looks in the process list), so
+    beside another test's Ray it would join that one instead of finding no cluster."""
+    import fcntl
+    import tempfile
+
+    with open(pathlib.Path(tempfile.gettempdir()) / f"twin-tests-ray-{os.getuid()}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        yield
+
+
 def _cli(*args, cwd, **kwargs):
     env = {**os.environ, "PYTHONPATH": str(ROOT)}
     return subprocess.Popen([sys.executable, "-m", "twin", "sweep", *args], cwd=cwd, env=env,
@@ -382,7 +395,7 @@ def test_a_stopped_ray_sweep_shuts_its_own_ray_down_without_cancelling_and_cance
 
 
 @pytest.mark.slow  # over ~2.5 s on 2 cores
-def test_ray_backend_gives_the_same_numbers_as_local(tmp_path):
+def test_ray_backend_gives_the_same_numbers_as_local(tmp_path, one_ray_at_a_time):
     ray = pytest.importorskip("ray")
     points = grid.expand({"controller": ["ffpva", "smc"], "trajectory": [2], "seed": [0, 1]})
     local = run_sweep(points, out=_mkdir(tmp_path / "local"), workers=1).records
@@ -496,7 +509,7 @@ def test_the_printed_summary_shows_no_negative_zero():
 
 
 @pytest.mark.slow  # a Ray instance starts: ~10 s
-def test_a_kill_stops_a_ray_sweep_as_ctrl_c_does(tmp_path):
+def test_a_kill_stops_a_ray_sweep_as_ctrl_c_does(tmp_path, one_ray_at_a_time):
     """``ray.init`` took SIGTERM over: a kill during a Ray sweep ended it with exit 134 and a C++ stack dump, and
     no word of the finished scenarios (a helper's probe, stop 41; 9 of 9 tries). The sweep now puts the handlers
     back after starting Ray: one line, exit 130, the finished scenarios kept."""
@@ -524,10 +537,12 @@ def _stored(path: pathlib.Path) -> int:
     if not path.exists():
         return 0
     try:
-        with contextlib.closing(sqlite3.connect(f"file:{path}?mode=ro", uri=True, timeout=1)) as db:
+        with contextlib.closing(sqlite3.connect(f"{path.as_uri()}?mode=ro", uri=True, timeout=1)) as db:
             return db.execute("SELECT COUNT(*) FROM results").fetchone()[0]
-    except sqlite3.Error:
-        return 0
+    except sqlite3.OperationalError as error:  # locked, or its table not made yet; anything else fails the test
+        if "locked" in str(error) or "no such table" in str(error):
+            return 0
+        raise
 
 
 def test_a_kill_while_ray_starts_stops_the_sweep_as_ctrl_c_does(tmp_path, monkeypatch):
@@ -554,7 +569,7 @@ def test_a_kill_while_ray_starts_stops_the_sweep_as_ctrl_c_does(tmp_path, monkey
 
 
 @pytest.mark.slow  # Ray looks for a cluster: a few seconds
-def test_ray_address_auto_with_no_cluster_leaves_nothing(tmp_path):
+def test_ray_address_auto_with_no_cluster_leaves_nothing(tmp_path, one_ray_at_a_time):
     """`--ray-address auto` with no Ray cluster running is found only when Ray starts; it left the folder, its
     lock and an empty store, and said "finished scenarios are kept" of none (a helper's probe, stop 41). Now a
     one-line error that no scenario ran, and a folder made for it goes again."""

@@ -275,9 +275,9 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
 def kill_during_ray_start(cut_short: SystemExit, ray) -> None:
     """A kill that came while ``ray.init`` ran met Ray's own SIGTERM handler, ``sys.exit(15)``: the sweep
     ended with exit 15 and no word (stop 54's CI, on a busy machine where Ray took over 7 s to start). What
-    Ray started is shut down and the kill goes to the handler that was in force before Ray's (the CLI's
-    makes it a stop, as Ctrl-C: one line, exit 130). Any other exit, or a handler that lets the kill pass,
-    ends as Ray's would have."""
+    Ray started is shut down and the kill goes to the handler that was in force before Ray's, as if Ray had
+    not taken it: the CLI's makes it a stop, as Ctrl-C (one line, exit 130); the default one ends the
+    process. Any other exit, or a handler that lets the kill pass (ignored), ends with Ray's exit."""
     if cut_short.code != signal.SIGTERM or threading.current_thread() is not threading.main_thread():
         raise cut_short
     with contextlib.suppress(Exception):
