@@ -568,6 +568,25 @@ def test_a_kill_while_ray_starts_stops_the_sweep_as_ctrl_c_does(tmp_path, monkey
     assert shut == [True] and signal.getsignal(signal.SIGTERM) is before
 
 
+def test_handlers_put_back_hands_on_only_a_stop_the_block_took_over():
+    """The shared mechanism under the sweep's mend: an exit whose number is a stop signal is handed to the handler
+    put back only if the block replaced that signal's handler (Ray's ``sys.exit(15)``); argparse's exit 2 in a
+    block that left SIGINT alone stays exit 2."""
+    from twin.batch.stops import handlers_put_back
+
+    before = signal.signal(signal.SIGTERM, signal.default_int_handler)  # as the CLI's sigterm_as_interrupt sets it
+    try:
+        with pytest.raises(KeyboardInterrupt), handlers_put_back():
+            signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(signum))
+            sys.exit(signal.SIGTERM)
+        assert signal.getsignal(signal.SIGTERM) is signal.default_int_handler
+        with pytest.raises(SystemExit) as stop, handlers_put_back():
+            sys.exit(signal.SIGINT)  # 2, argparse's usage exit: SIGINT's handler untouched
+        assert stop.value.code == 2
+    finally:
+        signal.signal(signal.SIGTERM, before)
+
+
 @pytest.mark.slow  # Ray looks for a cluster: a few seconds
 def test_ray_address_auto_with_no_cluster_leaves_nothing(tmp_path, one_ray_at_a_time):
     """`--ray-address auto` with no Ray cluster running is found only when Ray starts; it left the folder, its

@@ -23,17 +23,29 @@ _depth = 0  # swallowed_stops_kept() blocks entered and not yet left (a command 
 @contextlib.contextmanager
 def handlers_put_back():
     """The stop signals' handlers as they were before the block, put back after it (a handler set outside
-    Python, ``None``, cannot be, and is left). Only the main thread may set handlers: elsewhere a no-op."""
+    Python, ``None``, cannot be, and is left). Only the main thread may set handlers: elsewhere a no-op.
+
+    A stop signal that came inside the block and met the block's own handler for it as ``sys.exit(signum)``
+    (``ray.init``'s for SIGTERM: exit 15 and no word, stop 54's CI) goes to the handler put back, as if the
+    block had not taken it: the CLI's makes it a stop, as Ctrl-C; the default one ends the process. A handler
+    put back that lets it pass (ignored) leaves the exit as it was; so does an exit whose number is a stop
+    signal whose handler the block did not replace (argparse's exit 2 is not a Ctrl-C)."""
     if threading.current_thread() is not threading.main_thread():
         yield
         return
     before = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
+    taken = None  # the stop signal that met the block's own handler, handed on once the handlers are back
     try:
         yield
+    except SystemExit as cut_short:
+        taken = next((s for s in STOP_SIGNALS if cut_short.code == s and signal.getsignal(s) is not before[s]), None)
+        raise
     finally:
         for signum, handler in before.items():
             if handler is not None:
                 signal.signal(signum, handler)
+        if taken is not None:  # the handler put back raises its stop in place of the exit, or lets the exit go on
+            signal.raise_signal(taken)
 
 
 @contextlib.contextmanager

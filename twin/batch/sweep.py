@@ -26,7 +26,6 @@ import multiprocessing
 import os
 import pathlib
 import signal
-import threading
 import tomllib
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures.process import BrokenProcessPool
@@ -253,8 +252,10 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
         except ConnectionError as error:  # ``auto`` with no cluster running: found only here
             raise ClusterNotStarted(f"could not reach the Ray cluster at {where or 'a local Ray'}: "
                                     f"{str(error).splitlines()[0]}; no scenario ran") from None
-        except SystemExit as cut_short:
-            kill_during_ray_start(cut_short, ray)
+        except BaseException:  # a stop while Ray started (a kill that met Ray's own handler is handed back as one
+            with contextlib.suppress(Exception):  # by handlers_put_back): what Ray had started goes with it
+                ray.shutdown()
+            raise
     pending = []
     try:
         cpus = workers or int(cluster(ray.cluster_resources).get("CPU", 1))
@@ -270,20 +271,6 @@ def _ray(points: Sequence[GridPoint], workers: int | None, address: str | None,
             else:  # the caller's Ray lives on: these tasks would run on in it
                 for ref in pending:
                     ray.cancel(ref)
-
-
-def kill_during_ray_start(cut_short: SystemExit, ray) -> None:
-    """A kill that came while ``ray.init`` ran met Ray's own SIGTERM handler, ``sys.exit(15)``: the sweep
-    ended with exit 15 and no word (stop 54's CI, on a busy machine where Ray took over 7 s to start). What
-    Ray started is shut down and the kill goes to the handler that was in force before Ray's, as if Ray had
-    not taken it: the CLI's makes it a stop, as Ctrl-C (one line, exit 130); the default one ends the
-    process. Any other exit, or a handler that lets the kill pass (ignored), ends with Ray's exit."""
-    if cut_short.code != signal.SIGTERM or threading.current_thread() is not threading.main_thread():
-        raise cut_short
-    with contextlib.suppress(Exception):
-        ray.shutdown()
-    signal.raise_signal(signal.SIGTERM)
-    raise cut_short
 
 
 def counting(bar) -> Callable[[int], None]:
