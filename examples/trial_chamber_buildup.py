@@ -22,16 +22,19 @@ it, and prints for each:
 
 Nothing is refitted around the moved value, and nothing here is installed: past the box is a diagnosis, not a
 fit. The result is recorded in docs/investigations.md (PVA T1 and the lag) and docs/prediction.md (the air and the T3
-cells, which the README sums up); a slow test in tests/experiments/test_trials.py holds the printed table.
+cells, which the README sums up); a slow test in tests/experiments/test_trials.py holds the printed table (CI runs
+three of its rows again, all fourteen with pytest's ``--every-kept-row``: docs/testing.md).
 
-About 9 min on 2 cores.
+About 9 min on 2 cores for all fourteen rows; ``--only NAME`` (repeatable, as the rows are named: ``--only "air
+0.12"``) runs the committed values and the named rows alone (CI's test runs three of them: docs/testing.md).
 
-    python examples/trial_chamber_buildup.py
+    python examples/trial_chamber_buildup.py [--only NAME ...]
 """
 
 from __future__ import annotations
 
 import argparse
+from collections.abc import Sequence
 
 import numpy as np
 
@@ -46,13 +49,18 @@ LEAK = (0.0, 3e-14, 6e-14, 1.2e-13)  # m^3/(Pa s) past each discharge valve; the
 SEED_SETS = (calibrate.FIT_SEEDS, *calibrate.NOISE_SEED_SETS)
 T3 = [(c, 3, g, o) for c in ("ffpva", "smc") for o in ("horizontal", "vertical") for g in THESIS_PAYLOADS_G]
 SHOWN = (("smc", 2), ("smc", 3), ("ffpva", 1))  # printed after PVA T1: (controller, trajectory), 0 g flat
+MOVED = tuple(f"air {x:g}" for x in AIR) + tuple(f"leak {x:g}" for x in LEAK)  # the rows after the committed one
 
 
-def main() -> None:
+def main(only: Sequence[str] | None = None) -> None:
+    """Print the committed values' row, then every row of :data:`MOVED` (or the ``only`` ones, in that order)."""
+    if only is not None and set(only) - set(MOVED):
+        raise ValueError(f"no such row: {', '.join(sorted(set(only) - set(MOVED)))}; the rows are {', '.join(MOVED)}")
     best = calibrated_values(NINTH_REFIT_FILE)
     points = [("committed", best)]
     points += [(f"air {x:g}", {**best, "air_fraction": x}) for x in AIR]
     points += [(f"leak {x:g}", {**best, "leak_conductance": x}) for x in LEAK]
+    points = [(name, values) for name, values in points if only is None or name == "committed" or name in only]
     all_seeds = tuple(s for seeds in SEED_SETS for s in seeds)
     print("values | cost on seeds 0-9 / 10-19 / 20-29 / 30-39 | over the committed's, set by set: mean (lowest to "
           "highest) | within 20 % of 21 (seeds 0-39) | PVA T1 (largest), SMC T2, SMC T3, FF+PVA T1 (deg, seeds "
@@ -78,5 +86,7 @@ def main() -> None:
 
 
 if __name__ == "__main__":  # --help says what it runs instead of running it
-    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
-    main()
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--only", action="append", choices=MOVED, metavar="NAME",
+                        help="run the committed values and this row alone (repeatable): " + ", ".join(MOVED))
+    main(parser.parse_args().only)

@@ -55,6 +55,18 @@ def deg(x: float) -> float:
     return math.degrees(x)
 
 
+def pytest_addoption(parser: pytest.Parser) -> None:
+    parser.addoption("--every-kept-row", action="store_true",
+                     help="the two longest kept-result reruns in tests/experiments/test_trials.py run every kept file "
+                          "and row, not CI's few (about 25 min more on 2 cores: docs/testing.md)")
+
+
+@pytest.fixture
+def every_kept_row(request: pytest.FixtureRequest) -> bool:
+    """Whether ``--every-kept-row`` was given: a rerun of kept results runs all of them, not CI's subset."""
+    return request.config.getoption("--every-kept-row")
+
+
 @pytest.fixture
 def ctrl_c_as_in_a_terminal():
     """SIGINT raising KeyboardInterrupt for the test, as in a terminal, whatever started pytest: a background job
