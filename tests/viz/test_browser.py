@@ -373,7 +373,10 @@ def test_live_page_plots_follows_the_server_and_reflows(live_twin, browser, page
     wait_until(page, lambda r: r["desired_deg"] > 100.0, what="T1's replay to rise")
     page.wait_for_timeout(600)
     assert_fills(view_fit(page))
-    assert_scene_rendered(screenshot(page, "live-vertical.png"), least=60)  # 800x600, gears seen edge-on
+    # 800x600, the gears seen edge-on. Where the screenshot falls in the replay depends on the machine's speed: 59
+    # brass pixels with the link at 131 deg over the gears (stop 55's CI run, which failed the bar of 60 then) and
+    # 78 with it at 30 deg (a run after it). Half the lowest seen, as above; a blank or unlit scene has none.
+    assert_scene_rendered(screenshot(page, "live-vertical.png"), least=30)
 
     proc.send_signal(signal.SIGINT)  # the twin stops: the page says so (not "connection lost")
     page.wait_for_function("window.twinConnection === 'stopped'", timeout=10_000)
