@@ -58,7 +58,7 @@ def deg(x: float) -> float:
 def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addoption("--every-kept-row", action="store_true",
                      help="the two longest kept-result reruns in tests/experiments/test_trials.py run every kept file "
-                          "and row, not CI's few (estimated 10-35 min more on 2 cores: docs/testing.md)")
+                          "and row, not CI's few (docs/testing.md says which, and how much longer that takes)")
 
 
 @pytest.fixture
