@@ -407,18 +407,62 @@ def test_cells_of_picks_the_runs_of_the_wanted_seeds():
     assert twice.rmse_deg == (4.0,) and twice.failed == 1  # a seed asked for twice is one run
 
 
-@pytest.mark.slow  # over ~2.5 s on 2 cores
+class _SumOfSquares:
+    """A stand-in for :class:`calibrate.Evaluator`: one "cell", the squared distance of the values from a point
+    inside the unit box, so a fit's stages run in a blink. It records the values it was asked for, in order."""
+
+    asked: list[dict[str, float]] = []
+
+    def __init__(self, *, seeds, workers):
+        type(self).asked = []
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *error):
+        pass
+
+    def cells(self, values, *, seeds=None):
+        self.asked.append(dict(values))
+        return [float(np.sum((np.array(calibrate.unit_of(values)) - 0.3) ** 2))]
+
+
+def test_a_fit_evaluates_every_further_start_at_exactly_its_values_by_default(monkeypatch):
+    """With no ``previous`` given, the fit evaluates all of :func:`calibrate.previous_fits`, in order and as given
+    (not through the unit box), after the simplex and before the noise and the profiles. The slow test below runs
+    the real cells on two of them only."""
+    monkeypatch.setattr(calibrate, "Evaluator", _SumOfSquares)
+    monkeypatch.setattr(calibrate, "cost", lambda cells: cells[0])
+    result = calibrate.calibrate(workers=1, fit_seeds=(0,), check_seeds=(), noise_seed_sets=((1,),), scan_points=1,
+                                 simplex_evaluations=1, profile_points=2)
+    starts, asked = list(calibrate.previous_fits()), _SumOfSquares.asked
+    n = len(starts)
+    # "exactly" has teeth only if some start's values move on the unit box's round trip
+    assert any(calibrate.values_at(calibrate.unit_of(s)) != s for s in starts)
+    assert [e.stage for e in result.history] == ["scan", "scan", "simplex"] + ["previous"] * n + ["profile"] * 12
+    assert [e.values for e in result.history[3:3 + n]] == starts == asked[3:3 + n]
+    # then the noise (not in the history) at the best values so far, then the profiles
+    assert asked[3 + n] == min(result.history[:3 + n], key=lambda e: e.cost).values
+    assert result.evaluations == 3 + n + 12 and len(asked) == 3 + n + 1 + 12
+
+
+@pytest.mark.slow  # 67-142 s alone on 2 cores by machine with two further starts (128-270 s with all nineteen)
 def test_same_seeds_same_fit_whatever_the_workers():
+    """One worker or two, the same fit, through every stage: two of the further starts, the first and the first
+    whose values move on the unit box's round trip (the fast test above holds all of them, in order and at
+    exactly their values, with a stand-in for the cells)."""
+    starts = calibrate.previous_fits()
+    two_starts = (starts[0], next(s for s in starts if calibrate.values_at(calibrate.unit_of(s)) != s))
     small = dict(fit_seeds=(0, 1), check_seeds=(0,), noise_seed_sets=((2, 3),), scan_points=1,
-                 simplex_evaluations=1, profile_points=2)
+                 simplex_evaluations=1, profile_points=2, previous=two_starts)
     one = calibrate.calibrate(workers=1, **small)
     two = calibrate.calibrate(workers=2, **small)
     assert one.values == two.values and one.cost == two.cost and one.noise_costs == two.noise_costs
     assert [e.values for e in one.history] == [e.values for e in two.history]
-    # the nineteen further starts, evaluated at exactly their values, then two points along each profiled parameter
+    # the two further starts, evaluated at exactly their values, then two points along each profiled parameter
     # (the load friction, the breakaway, the observer gain, the CCW scale, the air, the start pressure)
-    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["previous"] * 19 + ["profile"] * 12
-    assert [e.values for e in one.history[3:22]] == list(calibrate.previous_fits()) and one.evaluations == 34
+    assert [e.stage for e in one.history] == ["scan", "scan", "simplex"] + ["previous"] * 2 + ["profile"] * 12
+    assert [e.values for e in one.history[3:5]] == list(two_starts) and one.evaluations == 17
     assert one.ensemble[0].values == one.values
     # The check seed 0 is one of the fit's: its cells are cut from the fit's runs and equal a run of seed 0.
     alone = calibrate.Evaluator(seeds=(0,), workers=1).cells(one.values)
