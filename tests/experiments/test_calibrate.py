@@ -446,13 +446,13 @@ def test_a_fit_evaluates_every_further_start_at_exactly_its_values_by_default(mo
     assert result.evaluations == 3 + n + 12 and len(asked) == 3 + n + 1 + 12
 
 
-@pytest.mark.slow  # 67-142 s alone on 2 cores by machine with two further starts (128-270 s with all nineteen)
+@pytest.mark.slow  # 67 s alone on 2 cores with two further starts, 128 s with all nineteen (stop 57's machine)
 def test_same_seeds_same_fit_whatever_the_workers():
     """One worker or two, the same fit, through every stage: two of the further starts, the first and the first
     whose values move on the unit box's round trip (the fast test above holds all of them, in order and at
     exactly their values, with a stand-in for the cells)."""
     starts = calibrate.previous_fits()
-    two_starts = (starts[0], next(s for s in starts if calibrate.values_at(calibrate.unit_of(s)) != s))
+    two_starts = (starts[0], next(s for s in starts[1:] if calibrate.values_at(calibrate.unit_of(s)) != s))
     small = dict(fit_seeds=(0, 1), check_seeds=(0,), noise_seed_sets=((2, 3),), scan_points=1,
                  simplex_evaluations=1, profile_points=2, previous=two_starts)
     one = calibrate.calibrate(workers=1, **small)
