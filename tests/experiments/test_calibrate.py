@@ -407,14 +407,18 @@ def test_cells_of_picks_the_runs_of_the_wanted_seeds():
     assert twice.rmse_deg == (4.0,) and twice.failed == 1  # a seed asked for twice is one run
 
 
+def _moves_on_the_round_trip(values: dict[str, float]) -> bool:
+    """Whether ``values`` come back other than they went in through the unit box (:func:`calibrate.unit_of`,
+    then :func:`calibrate.values_at`): a start evaluated through the box would then not be evaluated as given."""
+    return calibrate.values_at(calibrate.unit_of(values)) != values
+
+
 class _SumOfSquares:
     """A stand-in for :class:`calibrate.Evaluator`: one "cell", the squared distance of the values from a point
-    inside the unit box, so a fit's stages run in a blink. It records the values it was asked for, in order."""
+    inside the unit box, so a fit's stages run in a blink. It appends the values it is asked for to ``asked``."""
 
-    asked: list[dict[str, float]] = []
-
-    def __init__(self, *, seeds, workers):
-        type(self).asked = []
+    def __init__(self, asked: list[dict[str, float]]):
+        self.asked = asked
 
     def __enter__(self):
         return self
@@ -431,14 +435,15 @@ def test_a_fit_evaluates_every_further_start_at_exactly_its_values_by_default(mo
     """With no ``previous`` given, the fit evaluates all of :func:`calibrate.previous_fits`, in order and as given
     (not through the unit box), after the simplex and before the noise and the profiles. The slow test below runs
     the real cells on two of them only."""
-    monkeypatch.setattr(calibrate, "Evaluator", _SumOfSquares)
+    asked: list[dict[str, float]] = []
+    monkeypatch.setattr(calibrate, "Evaluator", lambda *, seeds, workers: _SumOfSquares(asked))
     monkeypatch.setattr(calibrate, "cost", lambda cells: cells[0])
     result = calibrate.calibrate(workers=1, fit_seeds=(0,), check_seeds=(), noise_seed_sets=((1,),), scan_points=1,
                                  simplex_evaluations=1, profile_points=2)
-    starts, asked = list(calibrate.previous_fits()), _SumOfSquares.asked
+    starts = list(calibrate.previous_fits())
     n = len(starts)
     # "exactly" has teeth only if some start's values move on the unit box's round trip
-    assert any(calibrate.values_at(calibrate.unit_of(s)) != s for s in starts)
+    assert any(_moves_on_the_round_trip(s) for s in starts)
     assert [e.stage for e in result.history] == ["scan", "scan", "simplex"] + ["previous"] * n + ["profile"] * 12
     assert [e.values for e in result.history[3:3 + n]] == starts == asked[3:3 + n]
     # then the noise (not in the history) at the best values so far, then the profiles
@@ -452,7 +457,7 @@ def test_same_seeds_same_fit_whatever_the_workers():
     whose values move on the unit box's round trip (the fast test above holds all of them, in order and at
     exactly their values, with a stand-in for the cells)."""
     starts = calibrate.previous_fits()
-    two_starts = (starts[0], next(s for s in starts[1:] if calibrate.values_at(calibrate.unit_of(s)) != s))
+    two_starts = (starts[0], next(s for s in starts[1:] if _moves_on_the_round_trip(s)))
     small = dict(fit_seeds=(0, 1), check_seeds=(0,), noise_seed_sets=((2, 3),), scan_points=1,
                  simplex_evaluations=1, profile_points=2, previous=two_starts)
     one = calibrate.calibrate(workers=1, **small)
