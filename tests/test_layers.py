@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import ast
 import pathlib
+import re
 
 import pytest
 
@@ -150,3 +151,17 @@ def test_relative_imports_are_resolved():
 
 def test_a_cycle_is_caught():
     assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}}) == [["a", "b", "c"]]
+
+
+def test_the_validate_package_rooms_import_only_the_rooms_its_docstring_lists_before_them():
+    """``twin/experiments/validate/__init__.py`` lists its modules in a table, each said to import only those
+    before it; the table must name every module of the package, and the imports must keep to that order."""
+    package = "twin.experiments.validate"
+    init = ast.get_docstring(ast.parse((ROOT / "twin/experiments/validate/__init__.py").read_text()))
+    rooms = [m.group(1) for line in init.splitlines() if (m := re.match(r"``(\w+)``\s", line))]
+    modules = {name for name in project_modules() if name.startswith(package + ".")}
+    assert sorted(f"{package}.{room}" for room in rooms) == sorted(modules)
+    edges = graph()
+    for k, room in enumerate(rooms):
+        siblings = {name.rpartition(".")[2] for name in edges[f"{package}.{room}"] if name.startswith(package + ".")}
+        assert siblings <= set(rooms[:k]), f"{room} imports {sorted(siblings - set(rooms[:k]))}, listed after it"

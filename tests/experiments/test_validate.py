@@ -13,8 +13,19 @@ import numpy as np
 import pytest
 
 from twin.experiments import calibrate, score, validate
-from twin.experiments.reference import THESIS_PAYLOADS_G
-from twin.plants.as_built import calibrated_values, calibration_cost_line, ensemble_costs, ensemble_values
+from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_FULL_DUTY_SPEEDS, THESIS_PAYLOADS_G
+from twin.experiments.validate.common import _row
+from twin.experiments.validate.markdown import _fixed_text, _spans_text
+from twin.experiments.validate.members import _members_table, _why_members
+from twin.experiments.validate.readings import _members_right_text
+from twin.experiments.validate.text import _band_ends_text, _numbers_text
+from twin.plants.as_built import (
+    FULL_DUTY_WINDOW,
+    calibrated_values,
+    calibration_cost_line,
+    ensemble_costs,
+    ensemble_values,
+)
 
 NINTH_PROFILED = ("load_friction", "stiction", "observer_gain", "ccw_coulomb_scale")  # before the air (2026-11-27)
 
@@ -140,7 +151,7 @@ def test_validate_without_a_calibration_is_a_one_line_error_and_writes_nothing(t
 
 def _fake(ratio_13_5: float, lag_within: bool, stalled: int, members: list | None = None,
           per_member: list | None = None) -> validate.Validation:
-    row = validate._row
+    row = _row
     rows = [row("chapter 5 experiment", c, t, 0.0, "horizontal", "as-built", m, m * k, 0.1, abs(k - 1) <= 0.2)
             for c, t, m, k in (("pva", 1, 4.2, 0.4), ("ffpva", 1, 1.4, 1.0), ("smc", 1, 1.19, 0.9),
                                ("pva", 2, 2.93, 0.75), ("ffpva", 2, 2.08, 1.0), ("smc", 2, 1.55, 1.5))]
@@ -237,7 +248,7 @@ def test_report_opens_with_what_is_within_what_is_out_and_what_the_prediction_sa
                     for c, g, x, n in (("ffpva", 0.0, 2.0, 0), ("smc", 0.0, 2.2, 0), ("ffpva", 6.5, 2.4, 0),
                                        ("smc", 6.5, 2.6, 0), ("ffpva", 13.5, 3.5, 1),
                                        ("smc", 13.5, 3.4, 2))]
-    row = validate._row
+    row = _row
     v.rows += [row("chapter 6 T1", "ffpva", 1, 6.5, "horizontal", "as-built", 1.69, 1.7, 0.1, True),  # not vertical
                row("4.4.3 valve test, R at 30 % duty (Pa s/m^3); below the 35 % checked", None, None, None, None,
                    "solenoid valve", 1.0, 2.0, None, False),
@@ -352,13 +363,13 @@ def test_report_says_when_the_members_disagree_on_which_law_leads_on_t3_and_whic
 
 
 def test_members_are_named_by_number_and_the_shorter_list():
-    assert validate._numbers_text([1]) == "member 1"
-    assert validate._numbers_text([0, 3]) == "members 0 and 3"
-    assert validate._numbers_text([0, 2, 5]) == "members 0, 2 and 5"
+    assert _numbers_text([1]) == "member 1"
+    assert _numbers_text([0, 3]) == "members 0 and 3"
+    assert _numbers_text([0, 2, 5]) == "members 0, 2 and 5"
     detail = {"members": [{}] * 5, "orders": [{1: "a"}] * 5}
-    assert validate._members_right_text(detail, 1, [0, 1, 2, 4]) == "right on 4 of the ensemble's 5 members (all but member 3)"
-    assert validate._members_right_text(detail, 1, [2, 4]) == "right on 2 of the ensemble's 5 members (members 2 and 4)"
-    assert validate._members_right_text(detail, 1, [0, 1, 2, 3, 4]) == "right on 5 of the ensemble's 5 members"
+    assert _members_right_text(detail, 1, [0, 1, 2, 4]) == "right on 4 of the ensemble's 5 members (all but member 3)"
+    assert _members_right_text(detail, 1, [2, 4]) == "right on 2 of the ensemble's 5 members (members 2 and 4)"
+    assert _members_right_text(detail, 1, [0, 1, 2, 3, 4]) == "right on 5 of the ensemble's 5 members"
 
 
 def test_the_members_table_gives_each_members_values_cost_cells_orders_and_lead():
@@ -376,7 +387,7 @@ def test_the_members_table_gives_each_members_values_cost_cells_orders_and_lead(
     v.prediction_detail.update(costs=[0.537, 0.559, 0.6], committed=0,
                                orders=[{1: rig, 2: "x"}, {1: rig, 2: rig}, {1: "x", 2: None}],
                                fitted_means=[{pva1: 4.0}, {pva1: 1.0}, {pva1: 4.5}])
-    table = validate._members_table(v)
+    table = _members_table(v)
     assert table[0] == "### The ensemble's members"
     rows = [line for line in table if line.startswith("| ")]
     assert rows[0].startswith("| member | load friction (N/N) | breakaway (N) | observer gain (1/s) | fit cost | "
@@ -388,9 +399,9 @@ def test_the_members_table_gives_each_members_values_cost_cells_orders_and_lead(
     assert "fit cost is the one the calibration recorded" in table[2] and "cost_line" not in v.prediction_detail
     v.prediction_detail["cost_line"] = (0.537, 0.05)  # best + noise 0.587: member 2's 0.600 lies outside
     assert ("(the best 0.537, its seed-to-seed noise 0.050): 2 of 3 members lie within the best plus the noise. "
-            in validate._members_table(v)[2])
+            in _members_table(v)[2])
     v.prediction_detail["committed"] = None  # the committed values are no member's: none marked
-    assert not any("(committed)" in line for line in validate._members_table(v))
+    assert not any("(committed)" in line for line in _members_table(v))
     rows = validate.member_rows(v)  # members.csv: the same, machine-readable
     assert [r["member"] for r in rows] == [0, 1, 2] and [r["committed"] for r in rows] == [False] * 3
     assert rows[1]["stiction"] == 1.09 and rows[1]["air_fraction"] is None  # a value the member does not carry
@@ -399,7 +410,7 @@ def test_the_members_table_gives_each_members_values_cost_cells_orders_and_lead(
     assert [r["chapter5_orders_right"] for r in rows] == ["1", "1 2", ""]
     assert [(r["t3_cells_ffpva_ahead"], r["t3_cells_smc_ahead"]) for r in rows] == [(2, 1), (0, 3), (3, 0)]
     v.prediction_detail["costs"] = [0.537, None, 0.6]  # a file without a member's cost: no cost column
-    assert "fit cost" not in validate._members_table(v)[4]
+    assert "fit cost" not in _members_table(v)[4]
     assert [r["fit_cost"] for r in validate.member_rows(v)] == [0.537, None, 0.6]
 
 
@@ -413,9 +424,9 @@ def test_a_one_member_ensemble_names_no_members_apart():
 
 
 def test_band_ends_are_said_as_members_or_interpolated_by_the_count():
-    assert validate._band_ends_text(11) == "with 11 members its ends are the second-lowest and the second-highest member's means"
-    assert validate._band_ends_text(21) == "with 21 members its ends are the third-lowest and the third-highest member's means"
-    assert validate._band_ends_text(9) == "with 9 members its ends are interpolated between neighbouring members"
+    assert _band_ends_text(11) == "with 11 members its ends are the second-lowest and the second-highest member's means"
+    assert _band_ends_text(21) == "with 21 members its ends are the third-lowest and the third-highest member's means"
+    assert _band_ends_text(9) == "with 9 members its ends are interpolated between neighbouring members"
     import numpy as np  # the claim itself: numpy's 10 % of 11 values is the second-lowest
 
     assert np.percentile(np.arange(11.0) ** 2, 10) == 1.0 and np.percentile(np.arange(9.0) ** 2, 10) != 1.0
@@ -428,9 +439,9 @@ def test_with_the_air_profiled_the_air_is_spanned_and_never_said_fixed():
     member = {"stiction": 1.79, "air_fraction": 0.046, "ccw_coulomb_scale": 1.15, "leak_conductance": 1.5e-14,
               "load_friction": 0.30, "observer_gain": 515.0}
     members = [member, dict(member, stiction=1.09)]
-    assert validate._fixed_text(members).startswith("Every member has the same leak 1.50 x 1e-14 m^3/(Pa s): the fit "
+    assert _fixed_text(members).startswith("Every member has the same leak 1.50 x 1e-14 m^3/(Pa s): the fit "
                                                     "does not profile it")
-    assert "air" not in validate._fixed_text(members) and "air 4.60 % (one value)" in validate._spans_text(members)
+    assert "air" not in _fixed_text(members) and "air 4.60 % (one value)" in _spans_text(members)
 
 
 def test_report_shows_what_sliding_modes_switching_term_does():
@@ -651,7 +662,7 @@ def test_seed_rows_count_the_five_run_groups_within_tolerance():
 
 def _seed_report(ffpva_t2: float = 2.1) -> tuple[validate.Validation, str]:
     v = _fake(1.0, lag_within=True, stalled=0)
-    v.rows.append(validate._row("chapter 5 experiment, T1 SSE range", "ffpva", 1, 0.0, "horizontal", "as-built", 0.77,
+    v.rows.append(_row("chapter 5 experiment, T1 SSE range", "ffpva", 1, 0.0, "horizontal", "as-built", 0.77,
                                 0.27, None, False))
     ffpva, smc, steady, smc1 = (("ffpva", 1, 0.0, "horizontal"), ("smc", 2, 0.0, "horizontal"),
                                 ("ffpva", 2, 0.0, "horizontal"), ("smc", 1, 0.0, "horizontal"))
@@ -790,7 +801,7 @@ def _miss_report() -> tuple[validate.Validation, list[dict], str]:
     """A made-up validation with one miss for each of misses()' readings; every number is worked by
     hand in the test below."""
     v = _fake(1.3, lag_within=True, stalled=0)  # sliding mode 13.5 g vertical: 4.524 on seeds 0-4, x1.30
-    row = validate._row
+    row = _row
     v.rows += [row("chapter 6 T1", "ffpva", 1, 6.5, "horizontal", "as-built", 1.69, 2.5, 0.1, False),
                row("chapter 5 experiment, T1 SSE range", "ffpva", 1, 0.0, "horizontal", "as-built", 0.77, 0.27, None,
                    False),
@@ -926,8 +937,8 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies(monkeypatch):
         "other way (0.10 deg) lies 4.0 of the two gaps' combined standard errors from the rig's")
     # Had the rig's sliding mode T2 runs scattered with a std of 0.9: 0.53 / sqrt((0.9^2 + 0.21^2) / 5) = 1.28, and
     # the twin's gap 0.63 / hypot(0.413, 0.063) = 1.51 from the rig's: both under 2, the rig's runs do not settle it.
-    smc_measured = validate.THESIS_EXPERIMENT_RMSE_DEG["smc"]
-    monkeypatch.setitem(validate.THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, 0.9)})
+    smc_measured = THESIS_EXPERIMENT_RMSE_DEG["smc"]
+    monkeypatch.setitem(THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, 0.9)})
     noise = validate.misses(v)[-1]
     assert (noise["trajectory"], noise["reading"]) == (2, "rig noise")
     assert noise["what_the_twin_shows"] == (
@@ -938,12 +949,12 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies(monkeypatch):
     # A std of 0.5: the rig's gap 2.19 apart, settled. A std of 0.6: the rig's gap 1.86, unsettled, but the twin's
     # 0.63 / hypot(0.284, 0.063) = 2.16 from it, further than the noise: not read as the rig's noise either.
     for std in (0.5, 0.6):
-        monkeypatch.setitem(validate.THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, std)})
+        monkeypatch.setitem(THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, std)})
         assert validate.misses(v)[-1]["reading"] == "open", std
     # Two pairs swapped, one within the noise (sliding mode and FF + PVA, as at 0.9) and one not (sliding mode
     # 1.80 behind PVA + DZC 1.75, which the rig had 2.78 combined standard errors apart): not the noise. PVA + DZC
     # is out (x0.60), and its measured value does not put the order right.
-    monkeypatch.setitem(validate.THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, 0.9)})
+    monkeypatch.setitem(THESIS_EXPERIMENT_RMSE_DEG, "smc", {**smc_measured, 2: (1.55, 0.9)})
     pva2 = next(r for r in v.rows if r["source"] == "chapter 5 experiment" and r["controller"] == "pva"
                 and r["trajectory"] == 2)
     pva2.update(twin_mean=1.75, ratio=1.75 / 2.93, within_tolerance=False)
@@ -951,7 +962,7 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies(monkeypatch):
     assert both["reading"] == "open" and "by 2.8 combined standard errors" in both["what_the_twin_shows"]
     assert both["what_the_twin_shows"].startswith("with the measured values in place of the cells that are out")
     pva2.update(twin_mean=2.93, ratio=1.0, within_tolerance=True)
-    monkeypatch.setitem(validate.THESIS_EXPERIMENT_RMSE_DEG, "smc", smc_measured)
+    monkeypatch.setitem(THESIS_EXPERIMENT_RMSE_DEG, "smc", smc_measured)
     fresh_t2 = {r["controller"]: r for r in v.seeds if r["trajectory"] == 2}
     fresh_t2["smc"]["twin_mean"] = 1.9  # right on the fresh seeds (1.9 < 2.1 < 2.9): the draw
     assert validate.misses(v)[-1]["reading"] == "draw" and validate.misses(v)[-1]["what_the_twin_shows"] == (
@@ -997,16 +1008,16 @@ def test_the_thesis_plants_full_duty_speed_is_eq_4_3_6s_steady_state():
     area = math.pi * 2e-3**2
     resistance = 1.8372e14 * 100.0**-2.1706  # eq. 4.4.2 at 100 % duty, Pa s/m^3
     viscous = 45.9  # N s/m, eq. 4.5.5
-    low, high = validate.FULL_DUTY_WINDOW
+    low, high = FULL_DUTY_WINDOW
     y = np.linspace(low, high, 20001)
     coulomb = np.maximum(np.polyval((-3.051e14, 1.587e13, -3.244e11, 3.294e9, -1.727e7, 4.36e4, -39.551), y), 0.0)
-    runs = validate.full_duty_runs([("thesis", pressure) for pressure, _, _ in validate.THESIS_FULL_DUTY_SPEEDS])
-    for (pressure, _, _), run in zip(validate.THESIS_FULL_DUTY_SPEEDS, runs, strict=True):
+    runs = validate.full_duty_runs([("thesis", pressure) for pressure, _, _ in THESIS_FULL_DUTY_SPEEDS])
+    for (pressure, _, _), run in zip(THESIS_FULL_DUTY_SPEEDS, runs, strict=True):
         expected = (high - low) / integrate.trapezoid((viscous + 2 * resistance * area**2) / (pressure * area - coulomb), y)
         assert run["warnings"] == 0 and run["speeds"] == pytest.approx((expected, expected), rel=2e-3)
         assert min(run["travel"]) > high - low
         # the same closed form in the physics layer, which the CCW friction's bound is worked out with
-        assert full_duty_speed(THESIS_PARAMS, pressure, validate.FULL_DUTY_WINDOW) == pytest.approx(expected, rel=1e-6)
+        assert full_duty_speed(THESIS_PARAMS, pressure, FULL_DUTY_WINDOW) == pytest.approx(expected, rel=1e-6)
 
 
 def _full_duty_run(cw: float, ccw: float, travel=(15e-3, 15e-3), warnings: int = 0) -> dict:
@@ -1058,7 +1069,7 @@ def test_every_ensemble_member_breaks_away_both_ways_at_245_kpa_as_the_force_los
     from twin.plants.as_built import as_built_plant, ensemble_plants
 
     plants = (as_built_plant(), *ensemble_plants())
-    runs = validate.full_duty_runs([(plant, validate.THESIS_FULL_DUTY_SPEEDS[0][0]) for plant in plants])
+    runs = validate.full_duty_runs([(plant, THESIS_FULL_DUTY_SPEEDS[0][0]) for plant in plants])
     for plant, run in zip(plants, runs, strict=True):
         cw, ccw = run["speeds"]
         assert run["warnings"] == 0 and 0.0 < ccw <= cw < 0.1, (plant.name, run)
@@ -1110,7 +1121,7 @@ def test_payload_phases_split_each_runs_squared_error_between_the_move_and_the_h
     of T1), make up the run's RMSE."""
     from twin.plants.as_built import calibrated_values
 
-    monkeypatch.setattr(validate, "SEEDS", (3,))
+    monkeypatch.setattr(validate.motion, "SEEDS", (3,))
     rows = validate.payload_phases(calibrated_values())
     assert {(r["controller"], r["payload_g"], r["orientation"]) for r in rows} == {
         (c, g, o) for c in ("ffpva", "smc") for g in (0.0, 6.5, 13.5) for o in ("horizontal", "vertical")}
@@ -1165,7 +1176,7 @@ def test_a_member_without_a_mean_is_not_counted_out_or_in():
     v = _fake(1.0, lag_within=True, stalled=0)
     pva2 = ("pva", 2, 0.0, "horizontal")  # committed x0.75, out
     v.prediction_detail["fitted_means"] = [{pva2: math.nan}, {pva2: 2.2}]
-    line = next(x for x in validate._why_members(v))
+    line = next(x for x in _why_members(v))
     assert "Out on every member" not in line  # one member has no mean: not known to be out there
 
 
@@ -1176,14 +1187,14 @@ def test_prediction_names_the_fitted_values_no_member_varies(monkeypatch):
     member = {"stiction": 1.09, "air_fraction": 0.0283, "ccw_coulomb_scale": 1.16, "leak_conductance": 1.39e-14,
               "load_friction": 0.29, "observer_gain": 340.0}
     members = [member, dict(member, leak_conductance=1.5e-14)]
-    text = validate._fixed_text(members)
+    text = _fixed_text(members)
     assert text.startswith("Every member has the same air 2.83 %: the fit does not profile it, so the band does "
                            "not show what it does. `twin whatif air` runs these cells")
     assert "breakaway" not in text and "leak" not in text  # profiled (shared or not), and varied
-    both = validate._fixed_text([member, dict(member)])
+    both = _fixed_text([member, dict(member)])
     assert "air 2.83 % and leak 1.39 x 1e-14 m^3/(Pa s): the fit does not profile them" in both  # neither varied
-    assert validate._fixed_text([member, dict(member, air_fraction=0.03, leak_conductance=1.5e-14)]) == ""
-    leak_only = validate._fixed_text([member, dict(member, air_fraction=0.03)])
+    assert _fixed_text([member, dict(member, air_fraction=0.03, leak_conductance=1.5e-14)]) == ""
+    leak_only = _fixed_text([member, dict(member, air_fraction=0.03)])
     assert leak_only.startswith("Every member has the same leak 1.39 x 1e-14 m^3/(Pa s): the fit does not profile it")
     assert "whatif" not in leak_only  # the pointer is the air's
 
