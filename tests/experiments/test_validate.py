@@ -14,7 +14,7 @@ import pytest
 
 from twin.experiments import calibrate, score, validate
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG, THESIS_FULL_DUTY_SPEEDS, THESIS_PAYLOADS_G
-from twin.experiments.validate.common import _row
+from twin.experiments.validate.comparisons import _row
 from twin.experiments.validate.markdown import _fixed_text, _spans_text
 from twin.experiments.validate.members import _members_table, _why_members
 from twin.experiments.validate.readings import _members_right_text

@@ -28,12 +28,14 @@ toward the held-back T3 measurements, which the twin does not have.
 The code is a package, one room a role, each importing only the rooms before it:
 
 ==============  ==============================================================================================
-``common``      the seeds, the tolerances and the verdicts on them, the files' columns, the fresh seeds
+``common``      the seeds, the tolerances and the verdicts on them, the files' columns, the fresh seeds, and
+                how the report names a fitted parameter (:data:`PARAMETER_TEXT`)
 ``comparisons`` the published comparisons, run (simulations, measured cells, valve, full-duty speeds, open loop)
-``motion``      how the controllers move the joint: sliding mode's parts, the opening lag, the pulse cycle
+``motion``      how the controllers move the joint: sliding mode's parts, the opening lag, the pulse cycle,
+                where in T1 a payload costs
 ``ensemble``    the T3 prediction over the ensemble; each member's orders and leads
 ``run``         :func:`validate` and its :class:`Validation`
-``text``        small pieces of the report's wording
+``text``        small pieces of the report's wording (numbers, lists, cell names, a parameter's value)
 ``readings``    every miss and its reading (``misses.csv``)
 ``members``     the members' table and ``members.csv``
 ``markdown``    ``validation.md``
@@ -42,7 +44,9 @@ The code is a package, one room a role, each importing only the rooms before it:
 ==============  ==============================================================================================
 
 Every public name of every room is imported here, so ``from twin.experiments.validate import X`` finds it;
-a private helper is imported from its room.
+a private helper is imported from its room. A room reads a shared constant (``SEEDS`` and the like) as its own
+global, so a test that patches one patches it on the room whose function reads it, not on this package, where
+the patch would change nothing.
 """
 
 from __future__ import annotations

@@ -1,9 +1,8 @@
 """What every part of ``twin validate`` shares: the seeds, the tolerances and the verdicts on them, the
-files' columns, the fresh seeds, and how the report names a fitted parameter."""
+files' columns, the fresh seeds, and how the report names a fitted parameter (its wording is in
+:mod:`twin.experiments.validate.text`)."""
 
 from __future__ import annotations
-
-from collections.abc import Sequence
 
 from twin.experiments import calibrate
 from twin.experiments.reference import ROBUSTNESS_CELLS
@@ -31,24 +30,6 @@ def rmse_within(twin: float, measured: float) -> bool:
     """Whether a twin's RMSE mean is within :data:`RMSE_TOLERANCE` of the measured one (False for nan; a
     numpy bool for numpy numbers)."""
     return abs(twin / measured - 1) <= RMSE_TOLERANCE
-
-
-def _with_unit(text: str, unit: str) -> str:
-    return f"{text} {unit}" if unit else text
-
-
-def _member_text(member: dict, names: Sequence[str]) -> str:
-    """``member``'s values of ``names``, as the report writes them ("breakaway 1.21 N, load friction ...")."""
-    return ", ".join(f"{PARAMETER_TEXT[n][0]} {_with_unit(PARAMETER_TEXT[n][1](member[n]), PARAMETER_TEXT[n][2])}"
-                     for n in names)
-
-
-def _profiled(members: Sequence[dict]) -> list[str]:
-    """The parameters to show across ``members``: the profiled ones every member carries, in the fit's order,
-    then any other they differ in (a simplex step may have moved it)."""
-    carried = [n for n in PARAMETER_TEXT if all(n in m for m in members)]
-    return ([n for n in calibrate.PROFILED if n in carried]
-            + [n for n in carried if n not in calibrate.PROFILED and len({m[n] for m in members}) > 1])
 
 
 PREDICTION_CELLS = tuple(cell for cell in ROBUSTNESS_CELLS if cell[1] == 3)  # the held-back T3 cells
@@ -86,14 +67,6 @@ SEED_COLUMNS = ("controller", "trajectory", "payload_g", "orientation", "measure
                 "sse_within_tolerance", "sse_groups_within", "sse_group_low", "sse_group_high", "sse_group_ranges")
 EFFECT_COLUMNS = ("controller", "payload_g", "orientation", "measured_effect", "measured_se", "twin_effect", "twin_se",
                   "difference_in_se")
-
-
-def _row(source, controller, trajectory, payload_g, orientation, plant, measured, twin_mean, twin_std,
-         within) -> dict:
-    ratio = twin_mean / measured if measured not in (None, 0) and twin_mean is not None else None
-    return {"source": source, "controller": controller, "trajectory": trajectory, "payload_g": payload_g,
-            "orientation": orientation, "plant": plant, "measured": measured, "twin_mean": twin_mean,
-            "twin_std": twin_std, "ratio": ratio, "within_tolerance": bool(within)}
 
 
 def stalled_runs(cell: calibrate.CellResult) -> int:

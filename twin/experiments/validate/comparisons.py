@@ -20,13 +20,20 @@ from twin.experiments.validate.common import (
     SEEDS,
     SIMULATION_TOLERANCE_DEG,
     SPREAD_CONFIDENCE,
-    _row,
     rmse_within,
     sse_within,
     stalled_runs,
 )
 from twin.plants.as_built import FULL_DUTY_SPEED_DIGIT, FULL_DUTY_WINDOW
 from twin.sim.metrics import spread
+
+
+def _row(source, controller, trajectory, payload_g, orientation, plant, measured, twin_mean, twin_std,
+         within) -> dict:
+    ratio = twin_mean / measured if measured not in (None, 0) and twin_mean is not None else None
+    return {"source": source, "controller": controller, "trajectory": trajectory, "payload_g": payload_g,
+            "orientation": orientation, "plant": plant, "measured": measured, "twin_mean": twin_mean,
+            "twin_std": twin_std, "ratio": ratio, "within_tolerance": bool(within)}
 
 
 def simulation_rows() -> list[dict]:

@@ -21,9 +21,6 @@ from twin.experiments.validate.common import (
     SPREAD_CONFIDENCE,
     SSE_TOLERANCE_DEG,
     STALL_ERROR_DEG,
-    _member_text,
-    _profiled,
-    _with_unit,
 )
 from twin.experiments.validate.comparisons import BROKE_AWAY, FULL_DUTY_PLANTS, FULL_DUTY_TURN, _judged
 from twin.experiments.validate.ensemble import controller_order, lead_counts, member_means, member_orders
@@ -37,10 +34,13 @@ from twin.experiments.validate.text import (
     _cell_name,
     _effect_name,
     _fmt,
+    _member_text,
     _numbers_text,
     _percent_span,
+    _profiled,
     _times,
     _which_members,
+    _with_unit,
 )
 from twin.plants.as_built import CCW_SCALE_BOUND, FULL_DUTY_SPEED_DIGIT, FULL_DUTY_WINDOW, fits_start_pressure
 from twin.sim.scenario import CONTROLLER_LABELS

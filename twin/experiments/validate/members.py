@@ -6,7 +6,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from twin.batch.tables import counted
-from twin.experiments.validate.common import PARAMETER_TEXT, RMSE_TOLERANCE, _profiled, _with_unit
+from twin.experiments.validate.common import PARAMETER_TEXT, RMSE_TOLERANCE
 from twin.experiments.validate.ensemble import (
     _member_within,
     _unknown_orders,
@@ -15,7 +15,7 @@ from twin.experiments.validate.ensemble import (
     member_orders,
 )
 from twin.experiments.validate.run import Validation
-from twin.experiments.validate.text import _cell_name, _numbers_text
+from twin.experiments.validate.text import _cell_name, _numbers_text, _profiled, _with_unit
 from twin.plants.as_built import FITTED
 from twin.sim.scenario import CONTROLLER_LABELS
 

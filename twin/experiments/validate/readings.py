@@ -12,8 +12,13 @@ from twin.experiments.validate.common import EFFECT_SIGNIFICANCE, RMSE_TOLERANCE
 from twin.experiments.validate.ensemble import _member_within, _unknown_orders, controller_order, member_orders
 from twin.experiments.validate.motion import SLOW_TRAJECTORIES
 from twin.experiments.validate.run import Validation
-from twin.experiments.validate.text import _cell_name, _fmt, _loaded, _measured_text, _times, _which_members
+from twin.experiments.validate.text import _cell_name, _fmt, _loaded, _times, _which_members
 from twin.sim.scenario import CONTROLLER_LABELS
+
+
+def _measured_text(controller: str, trajectory: int) -> str:
+    mean, std = THESIS_EXPERIMENT_RMSE_DEG[controller][trajectory]
+    return f"{mean:.2f} ± {std:.2f}"
 
 
 def _members_within_text(detail: dict, r: dict) -> str:

@@ -1,12 +1,32 @@
-"""Small pieces of the report's wording: numbers, lists, cell names."""
+"""Small pieces of the report's wording: numbers, lists, cell names, and a fitted parameter's name, value and unit
+(:data:`PARAMETER_TEXT`) across the ensemble's members."""
 
 from __future__ import annotations
 
 import math
 from collections.abc import Sequence
 
-from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
+from twin.experiments import calibrate
+from twin.experiments.validate.common import PARAMETER_TEXT
 from twin.sim.scenario import CONTROLLER_LABELS
+
+
+def _with_unit(text: str, unit: str) -> str:
+    return f"{text} {unit}" if unit else text
+
+
+def _member_text(member: dict, names: Sequence[str]) -> str:
+    """``member``'s values of ``names``, as the report writes them ("breakaway 1.21 N, load friction ...")."""
+    return ", ".join(f"{PARAMETER_TEXT[n][0]} {_with_unit(PARAMETER_TEXT[n][1](member[n]), PARAMETER_TEXT[n][2])}"
+                     for n in names)
+
+
+def _profiled(members: Sequence[dict]) -> list[str]:
+    """The parameters to show across ``members``: the profiled ones every member carries, in the fit's order,
+    then any other they differ in (a simplex step may have moved it)."""
+    carried = [n for n in PARAMETER_TEXT if all(n in m for m in members)]
+    return ([n for n in calibrate.PROFILED if n in carried]
+            + [n for n in carried if n not in calibrate.PROFILED and len({m[n] for m in members}) > 1])
 
 
 def _and_list(items: Sequence[str]) -> str:
@@ -56,11 +76,6 @@ def _percent_span(fractions: Sequence[float]) -> str:
 
 def _effect_name(r: dict) -> str:
     return f"{r['payload_g']:g} g {'H' if r['orientation'] == 'horizontal' else 'V'}"
-
-
-def _measured_text(controller: str, trajectory: int) -> str:
-    mean, std = THESIS_EXPERIMENT_RMSE_DEG[controller][trajectory]
-    return f"{mean:.2f} ± {std:.2f}"
 
 
 def _band_ends_text(members: int) -> str:
