@@ -1220,3 +1220,19 @@ def test_discharge_open_is_either_discharge_valve():
     """V2 or V4 (columns 1 and 3 of a trace's V1..V4), not the supply valves."""
     valve_open = np.array([[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1], [1, 1, 1, 1], [0, 0, 0, 0]], bool)
     assert validate.discharge_open(valve_open).tolist() == [False, True, False, True, True, False]
+
+
+def test_the_reports_tolerance_sentence_is_read_from_the_constants_that_judge(monkeypatch):
+    from twin.experiments.studies import valve
+    from twin.experiments.validate import markdown
+
+    assert markdown._tolerances_text() == (
+        "±0.35 deg for the thesis's simulations, 20 % for measured RMSE means, ±0.5 deg for T1 steady-error "
+        "ranges, 15 % for the valve's R(d) from 35 % duty, 1 ms for the valve's delays")
+    monkeypatch.setattr(markdown, "RMSE_TOLERANCE", 0.25)
+    monkeypatch.setattr(markdown, "DELAY_TOLERANCE", 2e-3)
+    monkeypatch.setattr(valve, "TOLERANCE", 0.10)
+    monkeypatch.setattr(valve, "CHECKED_FROM", 40.0)
+    text = markdown._tolerances_text()
+    assert "25 % for measured RMSE means" in text and "10 % for the valve's R(d) from 40 % duty" in text
+    assert text.endswith("2 ms for the valve's delays")

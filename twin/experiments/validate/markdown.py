@@ -12,6 +12,7 @@ from twin.batch.tables import counted
 from twin.experiments import calibrate
 from twin.experiments.reference import THESIS_FULL_DUTY_SPEEDS
 from twin.experiments.validate.common import (
+    DELAY_TOLERANCE,
     EFFECT_SIGNIFICANCE,
     FRESH_SEEDS,
     PARAMETER_TEXT,
@@ -463,9 +464,12 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
     checked = [r for r in v.rows if r["source"].startswith("4.4.3 valve test") and _judged(r)]
     delays = [r for r in v.rows if r["source"].startswith("4.4.3 valve") and "delay" in r["source"]]
     if checked or delays:
-        first += (f" The valve: R(d) within 15 % of eq. 4.4.2 at {sum(r['within_tolerance'] for r in checked)} of "
-                  f"{len(checked)} duties from 35 %, delays within 1 ms on {sum(r['within_tolerance'] for r in delays)}"
-                  f" of {len(delays)}.")
+        from twin.experiments.studies import valve
+
+        first += (f" The valve: R(d) within {valve.TOLERANCE * 100:.0f} % of eq. 4.4.2 at "
+                  f"{sum(r['within_tolerance'] for r in checked)} of {len(checked)} duties from "
+                  f"{valve.CHECKED_FROM:g} %, delays within {DELAY_TOLERANCE * 1e3:g} ms on "
+                  f"{sum(r['within_tolerance'] for r in delays)} of {len(delays)}.")
     rmse = [m for m in missed if m["comparison"] == "RMSE" and m["missed_on"] == "seeds 0-4"]
     orders = [m for m in missed if m["comparison"] == "controller order" and m["missed_on"] == "seeds 0-4"]
     sse = [r for r in v.rows if r["source"].endswith("T1 SSE range")]
@@ -514,6 +518,15 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
     return lines
 
 
+def _tolerances_text() -> str:
+    """Each comparison's tolerance, as the report's opening paragraph says it, from the constants that judge."""
+    from twin.experiments.studies import valve
+
+    return (f"±{SIMULATION_TOLERANCE_DEG:g} deg for the thesis's simulations, {RMSE_TOLERANCE * 100:.0f} % for measured "
+            f"RMSE means, ±{SSE_TOLERANCE_DEG:g} deg for T1 steady-error ranges, {valve.TOLERANCE * 100:.0f} % for the "
+            f"valve's R(d) from {valve.CHECKED_FROM:g} % duty, {DELAY_TOLERANCE * 1e3:g} ms for the valve's delays")
+
+
 def _terms() -> str:
     """The words the report uses, said once at its head."""
     from controllers.smc import SlidingModeGains
@@ -550,9 +563,7 @@ def report(v: Validation) -> str:
              "code and the committed as-built calibration, and the blind prediction of the Chapter 6 T3 cells. "
              "Closed-loop verdicts are on means over the thesis's five runs (seeds 0-4); the rows marked as a check "
              "run more seeds, and their section says how. Degrees unless named. "
-             "`within` is each comparison's tolerance: ±0.35 deg for the thesis's simulations, 20 % for measured "
-             "RMSE means, ±0.5 deg for T1 steady-error ranges, 15 % for the valve's R(d) from 35 % duty, 1 ms "
-             "for the valve's delays.", "",
+             f"`within` is each comparison's tolerance: {_tolerances_text()}.", "",
              _terms(), "",
              "## In short", "", *_in_short(v, missed), "",
              "## Summary", "", "| comparison | plant | within tolerance |", "|---|---|---|"]
