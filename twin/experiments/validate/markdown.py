@@ -11,6 +11,7 @@ import numpy as np
 from twin.batch.tables import counted
 from twin.experiments import calibrate
 from twin.experiments.reference import THESIS_FULL_DUTY_SPEEDS
+from twin.experiments.studies import valve as valve_study
 from twin.experiments.validate.common import (
     DELAY_TOLERANCE,
     EFFECT_SIGNIFICANCE,
@@ -464,11 +465,9 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
     checked = [r for r in v.rows if r["source"].startswith("4.4.3 valve test") and _judged(r)]
     delays = [r for r in v.rows if r["source"].startswith("4.4.3 valve") and "delay" in r["source"]]
     if checked or delays:
-        from twin.experiments.studies import valve
-
-        first += (f" The valve: R(d) within {valve.TOLERANCE * 100:.0f} % of eq. 4.4.2 at "
+        first += (f" The valve: R(d) within {valve_study.TOLERANCE * 100:.0f} % of eq. 4.4.2 at "
                   f"{sum(r['within_tolerance'] for r in checked)} of {len(checked)} duties from "
-                  f"{valve.CHECKED_FROM:g} %, delays within {DELAY_TOLERANCE * 1e3:g} ms on "
+                  f"{valve_study.CHECKED_FROM:g} %, delays within {DELAY_TOLERANCE * 1e3:g} ms on "
                   f"{sum(r['within_tolerance'] for r in delays)} of {len(delays)}.")
     rmse = [m for m in missed if m["comparison"] == "RMSE" and m["missed_on"] == "seeds 0-4"]
     orders = [m for m in missed if m["comparison"] == "controller order" and m["missed_on"] == "seeds 0-4"]
@@ -520,11 +519,9 @@ def _in_short(v: Validation, missed: Sequence[dict]) -> list[str]:
 
 def _tolerances_text() -> str:
     """Each comparison's tolerance, as the report's opening paragraph says it, from the constants that judge."""
-    from twin.experiments.studies import valve
-
     return (f"±{SIMULATION_TOLERANCE_DEG:g} deg for the thesis's simulations, {RMSE_TOLERANCE * 100:.0f} % for measured "
-            f"RMSE means, ±{SSE_TOLERANCE_DEG:g} deg for T1 steady-error ranges, {valve.TOLERANCE * 100:.0f} % for the "
-            f"valve's R(d) from {valve.CHECKED_FROM:g} % duty, {DELAY_TOLERANCE * 1e3:g} ms for the valve's delays")
+            f"RMSE means, ±{SSE_TOLERANCE_DEG:g} deg for T1 steady-error ranges, {valve_study.TOLERANCE * 100:.0f} % for the "
+            f"valve's R(d) from {valve_study.CHECKED_FROM:g} % duty, {DELAY_TOLERANCE * 1e3:g} ms for the valve's delays")
 
 
 def _terms() -> str:
