@@ -30,7 +30,7 @@ Nothing is installed. (Later on 2026-11-27 ``twin calibrate`` took this box and 
 added, as the tenth refit: docs/calibration-history.md. This script keeps running the search as it ran here, with
 no second start.) The fit takes 5-8 min on 2 cores.
 The result is recorded in docs/prediction.md and docs/calibration-history.md; a slow test in
-tests/experiments/test_trials.py holds the printed numbers.
+tests/experiments/test_trials_refits.py holds the printed numbers.
 
     python examples/trial_air_box.py [--out DIR] [--calibration FILE] [--workers N]
     python examples/trial_air_box.py --calibration FILE --validate DIR [--workers N]

@@ -57,8 +57,9 @@ def deg(x: float) -> float:
 
 def pytest_addoption(parser: pytest.Parser) -> None:
     parser.addoption("--every-kept-row", action="store_true",
-                     help="the two longest kept-result reruns in tests/experiments/test_trials.py run every kept file "
-                          "and row, not CI's few (docs/testing.md says which, and how much longer that takes)")
+                     help="the two longest kept-result reruns (tests/experiments/test_trials_refits.py's start refit, "
+                          "test_trials_effects.py's chambers) run every kept file and row, not CI's few "
+                          "(docs/testing.md says which, and how much longer that takes)")
 
 
 @pytest.fixture
