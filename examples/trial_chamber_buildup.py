@@ -22,8 +22,8 @@ it, and prints for each:
 
 Nothing is refitted around the moved value, and nothing here is installed: past the box is a diagnosis, not a
 fit. The result is recorded in docs/investigations.md (PVA T1 and the lag) and docs/prediction.md (the air and the T3
-cells, which the README sums up); a slow test in tests/experiments/test_trials_effects.py holds the printed table (CI runs
-three of its rows again, all fourteen with pytest's ``--every-kept-row``: docs/testing.md).
+cells, which the README sums up); a slow test in tests/experiments/test_trials_effects.py holds the printed table (CI
+runs three of its rows again, all fourteen with pytest's ``--every-kept-row``: docs/testing.md).
 
 About 9 min on 2 cores for all fourteen rows; ``--only NAME`` (repeatable, as the rows are named: ``--only "air
 0.12"``) runs the committed values and the named rows alone (CI's test runs three of them: docs/testing.md).

@@ -29,8 +29,8 @@ fraction, and first runs the measured cells again on its best values to show the
 instead (1-2 min; ``examples/trial_air_box.py``'s way of putting a trial file in place of the committed preset). The
 files of 2026-11-28 are in ``examples/trial_start_pressure_refit/``. Nothing is installed, and the T3 cells'
 measurements were not seen. The result is recorded in docs/investigations.md and docs/prediction.md; a slow test in
-tests/experiments/test_trials_refits.py holds the printed numbers of the kept files. (Their ``assumed`` entry for the start
-pressure was corrected after the fits, on a review: the fits had recorded the committed "half the supply".)
+tests/experiments/test_trials_refits.py holds the printed numbers of the kept files. (Their ``assumed`` entry for the
+start pressure was corrected after the fits, on a review: the fits had recorded the committed "half the supply".)
 
     python examples/trial_start_pressure_refit.py
     python examples/trial_start_pressure_refit.py --fraction F --calibration FILE [--workers N]

@@ -35,8 +35,9 @@ refusing a file of that name already there; ``--calibration FILE`` reports a fil
 was fitted at (checked by its ``code_version``, which hashes the trajectories as they ran), and first runs the
 measured cells again on its best values to show they give the file's table from that start. Nothing is installed,
 and the T3 cells' measurements were not seen. The results are recorded in docs/prediction.md and
-docs/investigations.md; a slow test in tests/experiments/test_trials_refits.py holds the printed numbers of the kept files
-(CI runs the eleventh code's file from 25 deg again, all four with pytest's ``--every-kept-row``: docs/testing.md).
+docs/investigations.md; a slow test in tests/experiments/test_trials_refits.py holds the printed numbers of the kept
+files (CI runs the eleventh code's file from 25 deg again, all four with pytest's ``--every-kept-row``:
+docs/testing.md).
 
     python examples/trial_start_refit.py
     python examples/trial_start_refit.py --start DEG --calibration FILE [--from-committed] [--workers N]

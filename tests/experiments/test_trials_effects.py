@@ -1,6 +1,9 @@
-"""The committed trial scripts that each read one effect or choice on a kept preset (a payload's cost, the
-start angle, the supply, a delay, sliding mode's compensation and lead, the chambers): they still print what the
-docs quote (mostly docs/as-built.md, docs/investigations.md, docs/prediction.md)."""
+"""The committed trial scripts that each read one effect or choice on a kept preset, nothing refitted: they still print
+what the docs quote (mostly docs/as-built.md, docs/investigations.md, docs/prediction.md). They are trial_payload_effect
+and trial_payload_cost_effects (what a payload costs), trial_pva_t1 (PVA + DZC on T1), trial_one_joint (five runs on
+one joint), trial_load_friction_edge, trial_t1_start, trial_t2_t3_choices, trial_chapter6_supply,
+trial_actuation_delay, trial_smc_compensation, trial_chamber_buildup (softer or leakier chambers),
+trial_initial_pressure (where the chambers' pressure starts) and trial_smc_lead."""
 
 from __future__ import annotations
 

@@ -1,5 +1,8 @@
-"""The committed trial scripts that refit the as-built plant another way (from other start angles and start
-pressures, with a wider air box), and the kept refits the trials ran on: they still report what the docs quote."""
+"""The committed trial scripts that refit the as-built plant another way (trial_start_refit and
+trial_start_pressure_refit from other start angles and start pressures, trial_air_box with a wider air box): they
+still report what the docs quote, fit only when asked, and refuse what would misplace calibrate's parameters. Also the
+kept refits the trials ran on (their preset digests) and the superseded blind predictions kept in examples/, as
+docs/prediction.md quotes them."""
 
 from __future__ import annotations
 
@@ -683,3 +686,40 @@ def test_the_twelfth_refit_kept_for_the_trials_is_the_preset_they_printed_on():
     # 6bb9e9258023: the committed preset of 2026-11-28 (stop 45) until the thirteenth refit (the same fitted values,
     # noise and profiles; another ensemble), that trial_profile_likelihood ran on; it reads this copy by default.
     assert as_built.preset_digest(as_built.TWELFTH_REFIT_FILE) == "6bb9e9258023"
+
+
+@pytest.mark.parametrize(("heading", "folder", "member_count"), [
+    ("## Beside the fifth: T3 on a trial refit", "trial_air_box", 11),
+    ("## Fifth blind prediction: T3 on the ninth refit", "ninth_refit_prediction", 9),  # superseded, kept as packaged
+    ("## Sixth blind prediction: T3 on the tenth refit", "tenth_refit_prediction", 11),  # superseded 2026-11-28
+    ("## Seventh blind prediction: T3 on the eleventh refit", "eleventh_refit_prediction", 13),  # superseded 2026-11-28
+    ("## Eighth blind prediction: T3 on the twelfth refit", "twelfth_refit_prediction", 13),  # superseded 2026-11-28
+])
+def test_prediction_md_quotes_the_registered_predictions_kept_in_examples(heading, folder, member_count):
+    import csv
+
+    text = (ROOT / "docs" / "prediction.md").read_text(encoding="utf-8")
+    section = text[text.index(heading):]
+    section = section[:section.index("\n## ")]
+    labels = {"FF + PVA": "ffpva", "sliding mode": "smc"}
+    quoted = {}
+    for line in section.splitlines():
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if len(cells) == 9 and cells[0] in labels:
+            quoted[labels[cells[0]], float(cells[1].split()[0]), cells[2]] = cells[3:9]
+    folder = ROOT / "examples" / folder
+    with open(folder / "prediction.csv", encoding="utf-8") as handle:
+        rows = list(csv.DictReader(handle))
+    members: dict[tuple, list[float]] = {}
+    with open(folder / "prediction_members.csv", encoding="utf-8") as handle:
+        for m in csv.DictReader(handle):
+            members.setdefault((m["controller"], float(m["payload_g"]), m["orientation"]), []).append(float(m["twin_mean"]))
+    assert len(rows) == len(quoted) == 12 and {len(v) for v in members.values()} == {member_count}
+    from twin.experiments import score
+
+    assert len(score.read_prediction(folder)) == 12  # `twin score --prediction` reads the folder
+    for r in rows:
+        key = (r["controller"], float(r["payload_g"]), r["orientation"])
+        wanted = [f"{float(r[k]):.2f}" for k in ("twin_mean", "band_p10", "band_p50", "band_p90")]
+        wanted += [f"{min(members[key]):.2f}-{max(members[key]):.2f}", r["stalled_runs"]]
+        assert quoted[key] == wanted, key
