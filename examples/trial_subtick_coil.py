@@ -3,9 +3,10 @@
 The twin switches each coil on the DAQ's 1 ms tick, so a held duty d opens the discharge coil for
 rint(d x 16 / 100) ticks of the 16 ms period, and a pulse opens the valve from 28.1 %. If the rig's PWM
 ended each pulse at its exact duty, the threshold would be the valve's own 26 %. This script runs the
-committed as-built preset both ways (FF + PVA and sliding mode, T1-T4, seeds 0-9) by swapping the two
-compiled valve kernels for sub-tick versions, and prints the mean RMSE per trajectory (deg). The result is
-recorded in docs/investigations.md.
+eighth refit's values (``examples/eighth_refit.json``, the committed preset when it first ran, 2026-11-25) both
+ways (FF + PVA and sliding mode, T1-T4, seeds 0-9) by swapping the two compiled valve kernels for sub-tick
+versions, and prints the mean RMSE per trajectory (deg). The result is recorded in docs/investigations.md; a slow
+test in tests/experiments/test_trials_effects.py holds the printed numbers.
 
 About 10 s on 2 cores.
 

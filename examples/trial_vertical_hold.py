@@ -2,11 +2,12 @@
 
 On the rig FF + PVA T1 went from 1.40 deg (horizontal) to 1.63 (vertical, 0 g); on the twin it goes the other
 way. The only force the vertical set-up adds at 0 g is the 0.6 g link's weight, at most 0.02 N at the rack
-(against about 3.8 N of P A). This script runs FF + PVA T1 on the eighth refit's preset (``eighth_refit.json``), seeds 0-39, flat and on
-its side, with the fitted leak past the discharge valves and without it, and prints the RMSE, the error
-during the 2 s hold (RMS over the hold, over its first and its last quarter second), when the move's last
+(against about 3.8 N of P A). This script runs FF + PVA T1 on the eighth refit's preset (``eighth_refit.json``),
+seeds 0-39, flat and on its side, with the fitted leak past the discharge valves and without it, and prints the RMSE,
+the error during the 2 s hold (RMS over the hold, over its first and its last quarter second), when the move's last
 discharge pulse opens, how far the joint goes after it, and the error at the end (mean and std). The result
-is recorded in docs/investigations.md.
+is recorded in docs/investigations.md; a slow test in tests/experiments/test_trials_effects.py holds the printed
+table.
 
     python examples/trial_vertical_hold.py
 """

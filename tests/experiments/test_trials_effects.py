@@ -3,7 +3,8 @@ what the docs quote (mostly docs/as-built.md, docs/investigations.md, docs/predi
 and trial_payload_cost_effects (what a payload costs), trial_pva_t1 (PVA + DZC on T1), trial_one_joint (five runs on
 one joint), trial_load_friction_edge, trial_t1_start, trial_t2_t3_choices, trial_chapter6_supply,
 trial_actuation_delay, trial_smc_compensation, trial_chamber_buildup (softer or leakier chambers),
-trial_initial_pressure (where the chambers' pressure starts) and trial_smc_lead."""
+trial_initial_pressure (where the chambers' pressure starts), trial_smc_lead, trial_subtick_coil (pulses that end at
+their exact duty), trial_t4_order (T4's order on each member) and trial_vertical_hold (FF + PVA T1 on its side)."""
 
 from __future__ import annotations
 
@@ -731,3 +732,69 @@ def test_the_docs_quote_the_smc_lead_trials_kept_output():
     as_built = " ".join((ROOT / "docs" / "as-built.md").read_text(encoding="utf-8").split())
     assert (f"on {smaller} of the 9 cells both were measured on (weaker by two standard errors on {weaker}, the three "
             f"misses among them; on this cell {flat_13[4]} against {flat_13[1]}), and by more on none") in as_built
+
+
+def _investigations() -> str:
+    """docs/investigations.md with its line breaks and runs of spaces as single spaces."""
+    return " ".join((ROOT / "docs" / "investigations.md").read_text(encoding="utf-8").split())
+
+
+@pytest.mark.slow  # about 10 s on 2 cores: two laws on T1-T4, ten seeds, two ways
+def test_trial_subtick_coil_prints_what_investigations_md_quotes(capsys):
+    load_trial("trial_subtick_coil").main()
+    out = capsys.readouterr().out.splitlines()
+    assert out == ["whole ticks  ffpva 1.62 / 2.24 / 2.19 / 1.95  smc 1.40 / 2.26 / 2.29 / 1.89",
+                   "sub-tick     ffpva 1.67 / 2.29 / 2.26 / 2.02  smc 1.47 / 2.30 / 2.41 / 2.20"]
+    (whole_ffpva, whole_smc), (sub_ffpva, sub_smc) = ([part.split(maxsplit=1)[1] for part in line[13:].split("  ")]
+                                                      for line in out)
+    assert (f"Sliding mode then tracked T1-T4 at {sub_smc} deg, against {whole_smc} with whole ticks. FF + PVA "
+            f"tracked at {sub_ffpva}, against {whole_ffpva}.") in _investigations()
+
+
+@pytest.mark.slow  # about 40 s on 2 cores: two laws on T4, nine members, 45 seeds
+def test_trial_t4_order_prints_what_investigations_md_quotes(capsys):
+    load_trial("trial_t4_order").main()
+    out = capsys.readouterr().out.splitlines()
+    assert out == [
+        "0 CCW 1.161 load 0.29 K_OB 340 leak 1.39e-14 | seeds 0-4: FF + PVA 1.722, SMC 1.904 | seeds 40-79: FF + PVA 1.735, SMC 1.806",
+        "1 CCW 1.161 load 0.38 K_OB 340 leak 1.16e-14 | seeds 0-4: FF + PVA 1.879, SMC 2.012 | seeds 40-79: FF + PVA 1.821, SMC 1.813",
+        "2 CCW 1.161 load 0.29 K_OB 272 leak 1.39e-14 | seeds 0-4: FF + PVA 1.695, SMC 1.979 | seeds 40-79: FF + PVA 1.738, SMC 1.856",
+        "3 CCW 1.067 load 0.29 K_OB 340 leak 1.39e-14 | seeds 0-4: FF + PVA 1.815, SMC 1.742 | seeds 40-79: FF + PVA 1.814, SMC 1.784",
+        "4 CCW 1.269 load 0.29 K_OB 340 leak 1.39e-14 | seeds 0-4: FF + PVA 2.057, SMC 1.966 | seeds 40-79: FF + PVA 2.125, SMC 1.911",
+        "5 CCW 1.141 load 0.29 K_OB 340 leak 1.39e-14 | seeds 0-4: FF + PVA 1.586, SMC 1.808 | seeds 40-79: FF + PVA 1.634, SMC 1.827",
+        "6 CCW 1.161 load 0.29 K_OB 340 leak 1.50e-14 | seeds 0-4: FF + PVA 1.675, SMC 1.785 | seeds 40-79: FF + PVA 1.714, SMC 1.805",
+        "7 CCW 1.161 load 0.30 K_OB 340 leak 1.39e-14 | seeds 0-4: FF + PVA 1.722, SMC 1.904 | seeds 40-79: FF + PVA 1.735, SMC 1.806",
+        "8 CCW 1.151 load 0.29 K_OB 340 leak 1.39e-14 | seeds 0-4: FF + PVA 1.613, SMC 1.897 | seeds 40-79: FF + PVA 1.664, SMC 1.830",
+    ]
+    verdict = [re.search(r"seeds 0-4: FF \+ PVA (\d\.\d+), SMC (\d\.\d+)", line).groups() for line in out]
+    right = sum(float(smc) < float(ffpva) for ffpva, smc in verdict)  # the rig: sliding mode ahead on T4
+    ffpva, smc = (f"{float(x):.2f}" for x in verdict[0])  # member 0 is the committed preset
+    text = _investigations()
+    assert f"T4 had turned (FF + PVA {ffpva} against sliding mode {smc}, measured 1.95 and 1.82)" in text
+    assert f"and was right on {right} of the {len(out)} on seeds 0-4" in text
+
+
+@pytest.mark.slow  # about 10 s on 2 cores: FF + PVA T1 flat and on its side, with and without the leak, 40 seeds
+def test_trial_vertical_hold_prints_what_investigations_md_quotes(capsys):
+    load_trial("trial_vertical_hold").main()
+    out = capsys.readouterr().out.splitlines()
+    assert out[1:] == [
+        "fitted leak  horizontal    1.63   1.33              2.30              0.34           0.879      5.33  +0.04 +- 0.33",
+        "fitted leak  vertical      1.39   0.88              1.22              0.65           0.875      5.35  -0.00 +- 0.69",
+        "no leak      horizontal    1.57   1.28              1.31              1.28           0.879      6.40  -1.01 +- 0.83",
+        "no leak      vertical      1.37   0.91              0.92              0.91           0.851      6.41  -0.28 +- 0.89",
+    ]
+    row = {" ".join(line.split()[:3]): line.split()[3:] for line in out[1:]}
+    leak_h, leak_v, dry_h, dry_v = (row[k] for k in ("fitted leak horizontal", "fitted leak vertical",
+                                                       "no leak horizontal", "no leak vertical"))
+    text = _investigations()
+    for quoted in (f"tracks better on its side than flat: {leak_v[0]} against {leak_h[0]} deg",
+                   f"RMS error {leak_v[1]} on its side against {leak_h[1]} flat",
+                   f"the hold gives {dry_v[1]} against {dry_h[1]}",
+                   f"at {dry_v[4]} s on its side and {dry_h[4]} s flat",
+                   f"goes on {float(dry_v[5]):.1f} deg in both cases",
+                   f"ends at \N{MINUS SIGN}{dry_v[6][1:]} \u00b1 {dry_v[8]} deg against \N{MINUS SIGN}{dry_h[6][1:]} "
+                   f"\u00b1 {dry_h[8]}",
+                   f"(flat: {leak_h[2]} to {leak_h[3]} deg; on its side: {leak_v[2]} to {leak_v[3]})"):
+        assert quoted in text, quoted
+    assert f"{float(dry_h[5]):.1f}" == f"{float(dry_v[5]):.1f}"  # "in both cases"
