@@ -4,7 +4,8 @@ and trial_payload_cost_effects (what a payload costs), trial_pva_t1 (PVA + DZC o
 one joint), trial_load_friction_edge, trial_t1_start, trial_t2_t3_choices, trial_chapter6_supply,
 trial_actuation_delay, trial_smc_compensation, trial_chamber_buildup (softer or leakier chambers),
 trial_initial_pressure (where the chambers' pressure starts), trial_smc_lead, trial_subtick_coil (pulses that end at
-their exact duty), trial_t4_order (T4's order on each member) and trial_vertical_hold (FF + PVA T1 on its side)."""
+their exact duty), trial_t4_order (T4's order on each member), trial_vertical_hold (FF + PVA T1 on its side) and
+trial_t1_direction (T1 the other way)."""
 
 from __future__ import annotations
 
@@ -798,3 +799,33 @@ def test_trial_vertical_hold_prints_what_investigations_md_quotes(capsys):
                    f"(flat: {leak_h[2]} to {leak_h[3]} deg; on its side: {leak_v[2]} to {leak_v[3]})"):
         assert quoted in text, quoted
     assert f"{float(dry_h[5]):.1f}" == f"{float(dry_v[5]):.1f}"  # "in both cases"
+
+
+@pytest.mark.slow  # about 7 s on 2 cores: three laws on T1 both ways, ten seeds
+def test_trial_t1_direction_prints_what_investigations_md_quotes(capsys):
+    import twin.sim.simulation as simulation
+
+    committed = simulation.trajectory
+    load_trial("trial_t1_direction").main()
+    assert simulation.trajectory is committed  # the trial puts T1 back
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("T1 on the committed as-built preset (13aadbb61885), seeds 0-9")
+    assert out[1:] == [
+        "pva    30 to 150 deg  1.90 ± 0.18, largest 8.5 (9.7), move 3.05 hold 0.90, SSE ±0.43 / ±0.64",
+        "pva    150 to 30 deg  1.91 ± 0.23, largest 7.6 (9.6), move 2.87 hold 1.20, SSE ±1.11 / ±0.68",
+        "ffpva  30 to 150 deg  1.49 ± 0.36, largest 6.3 (7.3), move 2.23 hold 1.01, SSE ±0.42 / ±0.81",
+        "ffpva  150 to 30 deg  1.57 ± 0.21, largest 6.7 (7.6), move 2.21 hold 1.15, SSE ±1.10 / ±1.30",
+        "smc    30 to 150 deg  1.37 ± 0.24, largest 6.3 (6.9), move 2.15 hold 0.77, SSE ±0.47 / ±0.95",
+        "smc    150 to 30 deg  1.54 ± 0.38, largest 5.9 (6.9), move 2.11 hold 1.24, SSE ±0.88 / ±1.05",
+    ]
+    names = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
+    text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
+    for line in out[1:]:
+        m = re.fullmatch(r"(\w+) +(\d+ to \d+ deg)  (\S+ ± \S+), largest (\S+) (\(\S+\)), move (\S+) hold (\S+), "
+                         r"SSE ±(\S+) / ±(\S+)", line)
+        law, way, rmse, mean, top, move, hold, first, second = m.groups()
+        assert (f"| {names[law]} | {way} | {rmse} | {mean} {top} | {move} / {hold} | {first} / {second} |"
+                in text), line
+    pva = [float(line.split()[5]) for line in out[1:3]]
+    assert f"tracks T1 at {pva[1]:.2f} deg against {pva[0]:.2f}, x{pva[0] / 4.20:.2f} of the rig's 4.20" \
+        in " ".join(text.split())
