@@ -1,7 +1,7 @@
 """Trial (not installed): Chapter 5's T4 controller order on every calibration ensemble member.
 
-The rig tracked T4 with sliding mode ahead of FF + PVA (1.82 against 1.95 deg); the committed preset
-puts FF + PVA ahead. This script runs both on T4 (0 g, horizontal) for each member of the ninth refit's
+The rig tracked T4 with sliding mode ahead of FF + PVA (1.82 against 1.95 deg); the ninth refit's
+preset put FF + PVA ahead. This script runs both on T4 (0 g, horizontal) for each member of the ninth refit's
 calibration ensemble (the committed one when it ran, kept in ``twin/plants/data/ninth_refit.json``), on seeds 0-4
 (the verdict's) and on seeds 40-79 (which no step of the fit ran), and prints the members' profiled values and the
 four means. Its result (2026-11-26) is in docs/investigations.md; a slow test in

@@ -769,7 +769,7 @@ def test_trial_t4_order_prints_what_investigations_md_quotes(capsys):
     ]
     verdict = [re.search(r"seeds 0-4: FF \+ PVA (\d\.\d+), SMC (\d\.\d+)", line).groups() for line in out]
     right = sum(float(smc) < float(ffpva) for ffpva, smc in verdict)  # the rig: sliding mode ahead on T4
-    ffpva, smc = (f"{float(x):.2f}" for x in verdict[0])  # member 0 is the committed preset
+    ffpva, smc = (f"{float(x):.2f}" for x in verdict[0])  # member 0: the ninth refit's fitted values
     text = _investigations()
     assert f"T4 had turned (FF + PVA {ffpva} against sliding mode {smc}, measured 1.95 and 1.82)" in text
     assert f"and was right on {right} of the {len(out)} on seeds 0-4" in text
@@ -802,14 +802,14 @@ def test_trial_vertical_hold_prints_what_investigations_md_quotes(capsys):
 
 
 @pytest.mark.slow  # about 7 s on 2 cores: three laws on T1 both ways, ten seeds
-def test_trial_t1_direction_prints_what_investigations_md_quotes(capsys):
+def test_trial_t1_direction_prints_what_the_docs_quote(capsys):
     import twin.sim.simulation as simulation
 
     committed = simulation.trajectory
     load_trial("trial_t1_direction").main()
     assert simulation.trajectory is committed  # the trial puts T1 back
     out = capsys.readouterr().out.splitlines()
-    assert out[0].startswith("T1 on the committed as-built preset (13aadbb61885), seeds 0-9")
+    assert out[0].startswith("T1 on the twelfth refit's values (6bb9e9258023; the committed preset's), seeds 0-9")
     assert out[1:] == [
         "pva    30 to 150 deg  1.90 ± 0.18, largest 8.5 (9.7), move 3.05 hold 0.90, SSE ±0.43 / ±0.64",
         "pva    150 to 30 deg  1.91 ± 0.23, largest 7.6 (9.6), move 2.87 hold 1.20, SSE ±1.11 / ±0.68",
@@ -817,15 +817,28 @@ def test_trial_t1_direction_prints_what_investigations_md_quotes(capsys):
         "ffpva  150 to 30 deg  1.57 ± 0.21, largest 6.7 (7.6), move 2.21 hold 1.15, SSE ±1.10 / ±1.30",
         "smc    30 to 150 deg  1.37 ± 0.24, largest 6.3 (6.9), move 2.15 hold 0.77, SSE ±0.47 / ±0.95",
         "smc    150 to 30 deg  1.54 ± 0.38, largest 5.9 (6.9), move 2.11 hold 1.24, SSE ±0.88 / ±1.05",
+        "mirrored minus committed, seed by seed: RMSE change mean ± its standard error (deg), seeds worse",
+        "pva    +0.01 ± 0.11 (+0.1 standard errors), worse on 4 of 10",
+        "ffpva  +0.09 ± 0.13 (+0.6 standard errors), worse on 7 of 10",
+        "smc    +0.17 ± 0.09 (+2.0 standard errors), worse on 8 of 10",
     ]
     names = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
-    text = (ROOT / "docs" / "investigations.md").read_text(encoding="utf-8")
-    for line in out[1:]:
+    text = _investigations()
+    for line in out[1:7]:
         m = re.fullmatch(r"(\w+) +(\d+ to \d+ deg)  (\S+ ± \S+), largest (\S+) (\(\S+\)), move (\S+) hold (\S+), "
-                         r"SSE ±(\S+) / ±(\S+)", line)
-        law, way, rmse, mean, top, move, hold, first, second = m.groups()
-        assert (f"| {names[law]} | {way} | {rmse} | {mean} {top} | {move} / {hold} | {first} / {second} |"
-                in text), line
+                         r"SSE (±\S+ / ±\S+)", line)
+        law, way, rmse, mean, top, move, hold, ranges = m.groups()
+        assert f"| {names[law]} | {way} | {rmse} | {mean} {top} | {move} / {hold} | {ranges} |" in text, line
+    change = {m[1]: m.groups()[1:] for m in (re.fullmatch(r"(\w+) +(\S+) ± (\S+) \(\+(\S+) standard errors\), worse on "
+                                                        r"(\d+) of 10", line) for line in out[8:])}
+    assert ("mean change of RMSE ± its standard error): PVA + DZC {0} ± {1} deg (worse on {3} of 10 seeds), FF + PVA "
+            "{4} ± {5} ({7} of 10), sliding mode {8} ± {9} ({11} of 10)").format(
+                *change["pva"], *change["ffpva"], *change["smc"]) in text
+    assert (f"FF + PVA's change is {change['ffpva'][2]} of its standard error, within the runs' scatter; sliding "
+            f"mode's is {change['smc'][2]}, at the edge of the two standard errors") in text
     pva = [float(line.split()[5]) for line in out[1:3]]
-    assert f"tracks T1 at {pva[1]:.2f} deg against {pva[0]:.2f}, x{pva[0] / 4.20:.2f} of the rig's 4.20" \
-        in " ".join(text.split())
+    assert f"tracks T1 at {pva[1]:.2f} deg against {pva[0]:.2f}, x{pva[0] / 4.20:.2f} of the rig's 4.20" in text
+    assert f"{pva[0] / 4.20:.2f}" == f"{pva[1] / 4.20:.2f}"  # "either way"
+    assert max(float(line.split()[10].strip("(),")) for line in out[1:3]) < 10  # "stays under 10 deg"
+    assert (f"(150 to 30 deg: {pva[1]:.2f} deg mirrored against {pva[0]:.2f} as committed, seeds 0-9, stop 59)"
+            in " ".join((ROOT / "docs" / "as-built.md").read_text(encoding="utf-8").split()))
