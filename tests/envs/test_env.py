@@ -253,3 +253,26 @@ def test_a_trajectory_that_is_not_a_whole_number_is_refused(trajectory):
 def test_the_largest_seed_the_environment_takes_runs():
     env = joint_env.load("track", trajectory=2, seed=2**32 - 1)
     assert env.reset().first()
+
+
+def test_the_documented_example_runs_a_controller_as_a_policy_and_prints_twin_runs_rmse(capsys, monkeypatch):
+    """examples/run_policy.py, as docs/environment.md shows it (not installed): it runs the episode and prints the
+    return and the RMSE, which on the track task is twin run's for the same controller, trajectory and seed."""
+    import importlib.util
+    import math
+    import pathlib
+    import re
+    import sys
+
+    path = pathlib.Path(__file__).resolve().parents[2] / "examples" / "run_policy.py"
+    spec = importlib.util.spec_from_file_location("run_policy", path)
+    example = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(example)
+    monkeypatch.setattr(sys, "argv", [str(path), "--controller", "smc", "--trajectory", "3", "--seed", "2"])
+    example.main()
+    printed = capsys.readouterr().out
+    m = re.fullmatch(r"smc on track \(payload 0\.0 g, horizontal\): return (\S+) over 4000 ms, RMSE (\S+) deg\n",
+                     printed)
+    assert m, printed
+    assert m[2] == f"{math.degrees(run(Scenario('smc', 3, seed=2)).metrics.rmse):.3f}"
+    assert 0 < float(m[1]) <= 4000  # a reward in (0, 1] a step; sliding mode steps every 1 ms
