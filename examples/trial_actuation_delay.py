@@ -29,6 +29,7 @@ from __future__ import annotations
 import argparse
 import math
 import pathlib
+import sys
 
 import numpy as np
 
@@ -36,6 +37,9 @@ from twin.envs.runner import run_many
 from twin.physics.valves import ValveBank
 from twin.plants.as_built import NINTH_REFIT_FILE, as_built_plant, calibrated_values
 from twin.sim.scenario import Scenario
+
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling modules, however this one is loaded
+from trial_t1_start import t1_move_hold_sse  # noqa: E402
 
 SEEDS = range(10)
 DELAYS = (0, 1, 2, 3, 4, 5, 6, 8)  # ticks of 1 ms
@@ -97,21 +101,11 @@ def main() -> None:
               + " | pva T1 " + _t1_ending(results[:len(SEEDS)]), flush=True)
 
 
-def _sibling(name: str):
-    """Another trial script beside this one, loaded as a module (the examples are not a package)."""
-    import importlib.util
-
-    spec = importlib.util.spec_from_file_location(name, pathlib.Path(__file__).with_name(f"{name}.py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
-
-
 def _t1_ending(runs: list) -> str:
     """PVA + DZC's T1: the RMS error over the move (0-1 s) and over the hold (from 1 s), the SSE ranges of
     seeds 0-4 and 5-9 (the rig's: ±0.41), the smallest and largest |SSE| of the runs, and how many end
     more than 1 deg off."""
-    move, hold, sse, ranges = _sibling("trial_t1_start").t1_move_hold_sse(runs)
+    move, hold, sse, ranges = t1_move_hold_sse(runs)
     return (f"move {move:.2f} hold {hold:.2f} SSE {ranges}, runs end {np.nanmin(np.abs(sse)):.2f}-"
             f"{np.nanmax(np.abs(sse)):.2f} off, {int(np.sum(np.abs(sse) > 1.0))} of {len(sse)} over 1 deg")
 

@@ -21,9 +21,9 @@ docs/investigations.md; a slow test in tests/experiments/test_trials_effects.py 
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import math
 import pathlib
+import sys
 
 import numpy as np
 
@@ -33,17 +33,12 @@ from twin.physics.trajectories import Segment, Trajectory
 from twin.plants.as_built import TWELFTH_REFIT_FILE, as_built_plant, calibrated_values, preset_digest
 from twin.sim.scenario import Scenario
 
+sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))  # the sibling modules, however this one is loaded
+from trial_t1_start import t1_move_hold_sse  # noqa: E402
+
 SEEDS = range(10)
 LAWS = ("pva", "ffpva", "smc")
 PLANT = as_built_plant(calibrated_values(TWELFTH_REFIT_FILE))
-
-
-def _sibling(name: str):
-    """Another trial script beside this one, loaded as a module (the examples are not a package)."""
-    spec = importlib.util.spec_from_file_location(name, pathlib.Path(__file__).with_name(f"{name}.py"))
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
 
 
 def mirrored(committed):
@@ -63,7 +58,7 @@ def runs_of(law: str) -> tuple[np.ndarray, str]:
     docstring says (deg)."""
     runs = run_many([Scenario(law, 1, plant=PLANT, seed=s) for s in SEEDS])
     rmse, largest = (np.degrees([getattr(r.metrics, k) for r in runs]) for k in ("rmse", "max_error"))
-    move, hold, _, ranges = _sibling("trial_t1_start").t1_move_hold_sse(runs)
+    move, hold, _, ranges = t1_move_hold_sse(runs)
     return rmse, (f"{rmse.mean():.2f} ± {rmse.std(ddof=1):.2f}, largest {largest.mean():.1f} ({largest.max():.1f}), "
                   f"move {move:.2f} hold {hold:.2f}, SSE {ranges}")
 

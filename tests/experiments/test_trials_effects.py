@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 
 import pytest
-from trial_scripts import ROOT, load_trial
+from trial_scripts import ROOT, doc_text, load_trial
 
 
 @pytest.mark.slow  # about 25 s on 2 cores: twelve T1 cells, 40 seeds each
@@ -730,14 +730,9 @@ def test_the_docs_quote_the_smc_lead_trials_kept_output():
     ffpva_13 = float(re.search(r"^  T1 13.5 g horizontal .*, [\d.]+ / ([\d.]+)$", printed, re.M).group(1))
     assert f"x{ffpva_13 / TARGET_OF[('ffpva', 1, 13.5, 'horizontal')].rmse_deg:.2f} on the fresh seeds" in flat
     assert f"the rig's sliding mode tracked at {flat_13[1]} of its FF + PVA and the twin's at {flat_13[4]}" in flat
-    as_built = " ".join((ROOT / "docs" / "as-built.md").read_text(encoding="utf-8").split())
+    as_built = doc_text("as-built.md")
     assert (f"on {smaller} of the 9 cells both were measured on (weaker by two standard errors on {weaker}, the three "
             f"misses among them; on this cell {flat_13[4]} against {flat_13[1]}), and by more on none") in as_built
-
-
-def _investigations() -> str:
-    """docs/investigations.md with its line breaks and runs of spaces as single spaces."""
-    return " ".join((ROOT / "docs" / "investigations.md").read_text(encoding="utf-8").split())
 
 
 @pytest.mark.slow  # about 10 s on 2 cores: two laws on T1-T4, ten seeds, two ways
@@ -749,7 +744,7 @@ def test_trial_subtick_coil_prints_what_investigations_md_quotes(capsys):
     (whole_ffpva, whole_smc), (sub_ffpva, sub_smc) = ([part.split(maxsplit=1)[1] for part in line[13:].split("  ")]
                                                       for line in out)
     assert (f"Sliding mode then tracked T1-T4 at {sub_smc} deg, against {whole_smc} with whole ticks. FF + PVA "
-            f"tracked at {sub_ffpva}, against {whole_ffpva}.") in _investigations()
+            f"tracked at {sub_ffpva}, against {whole_ffpva}.") in doc_text("investigations.md")
 
 
 @pytest.mark.slow  # about 40 s on 2 cores: two laws on T4, nine members, 45 seeds
@@ -770,7 +765,7 @@ def test_trial_t4_order_prints_what_investigations_md_quotes(capsys):
     verdict = [re.search(r"seeds 0-4: FF \+ PVA (\d\.\d+), SMC (\d\.\d+)", line).groups() for line in out]
     right = sum(float(smc) < float(ffpva) for ffpva, smc in verdict)  # the rig: sliding mode ahead on T4
     ffpva, smc = (f"{float(x):.2f}" for x in verdict[0])  # member 0: the ninth refit's fitted values
-    text = _investigations()
+    text = doc_text("investigations.md")
     assert f"T4 had turned (FF + PVA {ffpva} against sliding mode {smc}, measured 1.95 and 1.82)" in text
     assert f"and was right on {right} of the {len(out)} on seeds 0-4" in text
 
@@ -788,7 +783,7 @@ def test_trial_vertical_hold_prints_what_investigations_md_quotes(capsys):
     row = {" ".join(line.split()[:3]): line.split()[3:] for line in out[1:]}
     leak_h, leak_v, dry_h, dry_v = (row[k] for k in ("fitted leak horizontal", "fitted leak vertical",
                                                        "no leak horizontal", "no leak vertical"))
-    text = _investigations()
+    text = doc_text("investigations.md")
     for quoted in (f"tracks better on its side than flat: {leak_v[0]} against {leak_h[0]} deg",
                    f"RMS error {leak_v[1]} on its side against {leak_h[1]} flat",
                    f"the hold gives {dry_v[1]} against {dry_h[1]}",
@@ -823,7 +818,7 @@ def test_trial_t1_direction_prints_what_the_docs_quote(capsys):
         "smc    +0.17 ± 0.09 (+2.0 standard errors), worse on 8 of 10",
     ]
     names = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
-    text = _investigations()
+    text = doc_text("investigations.md")
     for line in out[1:7]:
         m = re.fullmatch(r"(\w+) +(\d+ to \d+ deg)  (\S+ ± \S+), largest (\S+) (\(\S+\)), move (\S+) hold (\S+), "
                          r"SSE (±\S+ / ±\S+)", line)
@@ -841,4 +836,4 @@ def test_trial_t1_direction_prints_what_the_docs_quote(capsys):
     assert f"{pva[0] / 4.20:.2f}" == f"{pva[1] / 4.20:.2f}"  # "either way"
     assert max(float(line.split()[10].strip("(),")) for line in out[1:3]) < 10  # "stays under 10 deg"
     assert (f"(150 to 30 deg: {pva[1]:.2f} deg mirrored against {pva[0]:.2f} as committed, seeds 0-9, stop 59)"
-            in " ".join((ROOT / "docs" / "as-built.md").read_text(encoding="utf-8").split()))
+            in doc_text("as-built.md"))

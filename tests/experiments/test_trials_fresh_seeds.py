@@ -8,7 +8,7 @@ import json
 import re
 
 import pytest
-from trial_scripts import ROOT, StubEvaluator, load_trial
+from trial_scripts import ROOT, StubEvaluator, doc_text, load_trial
 
 # The fresh-seed trial's kept runs: on seeds 40-79 (stop 49, its reading written before it ran), then on 40-119
 # (decided after seeing that one, taking its costs on 40-79 and running 80-119), by the number of their seed sets.
@@ -140,7 +140,7 @@ def test_the_fresh_seed_trial_prints_the_kept_roughness(capsys):
     printed = capsys.readouterr().out
     assert printed == (ROOT / "examples" / "trial_fresh_seed_costs" / "roughness.txt").read_text()
     bins = re.findall(r"of the box: \d+ pairs, median (\d\.\d{3}), 90th percentile (\d\.\d{3})", printed)
-    text = " ".join((ROOT / "docs" / "investigations.md").read_text(encoding="utf-8").split())
+    text = doc_text("investigations.md")
     assert f"differ in cost by {bins[0][0]} (median; 90th percentile {bins[0][1]})" in text
     assert f"10-20 % apart ({bins[-1][0]};" in text
 
@@ -257,7 +257,7 @@ def test_the_docs_quote_the_band_trials_split():
     assert f"Without it the highest is still {ff[12]}-{ff[13]} and {smc[12]}-{smc[13]}" in flat
     assert f"registered band ({ff[9]} and {smc[9]} wide)" in flat
     assert f"The lowest moves less: {ff[3]}-{ff[4]} and {smc[3]}-{smc[4]}." in flat
-    prediction = " ".join((ROOT / "docs" / "prediction.md").read_text(encoding="utf-8").split())
+    prediction = doc_text("prediction.md")
     assert f"about half the same sets ({rows[0][9]}, median), and today's cut on ten seeds a third ({rows[2][9]})" \
         in prediction
     assert f"by more than the registered band is wide in {moving[0]} of the 12 cells" in prediction
@@ -345,7 +345,7 @@ def test_investigations_md_quotes_the_band_trials_kept_output():
     steady = dict(re.findall(r"^  (FF \+ PVA|sliding mode) +13\.5 g vertical *: .*with no stall ([\d.-]+), ", stalls,
                              flags=re.M))
     assert f"13.5 g vertical cells span {steady['FF + PVA']} and {steady['sliding mode']} deg" in flat
-    prediction = " ".join((ROOT / "docs" / "prediction.md").read_text(encoding="utf-8").split())
+    prediction = doc_text("prediction.md")
     assert (f"it stalls in {int(counted['FF + PVA']) + int(counted['sliding mode'])} of its 10 runs of the 13.5 g "
             "vertical cells") in prediction
     v0 = [(c[5], c[4], c[7]) for c in cells if c[1:3] == ("13.5", "vertical")]  # FF + PVA, then sliding mode

@@ -1,5 +1,5 @@
 """What the trial-script tests share (tests/experiments/test_trials_*.py): the checkout's root, a loader for a script
-in examples/ (not installed), and a stand-in for calibrate.Evaluator."""
+in examples/ (not installed), a doc page's words, and a stand-in for calibrate.Evaluator."""
 
 from __future__ import annotations
 
@@ -15,6 +15,11 @@ def load_trial(name: str):
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     return module
+
+
+def doc_text(name: str) -> str:
+    """docs/NAME with its line breaks and runs of spaces as single spaces, as the trial tests find quotes in it."""
+    return " ".join((ROOT / "docs" / name).read_text(encoding="utf-8").split())
 
 
 class StubEvaluator:
