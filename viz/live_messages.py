@@ -75,7 +75,7 @@ def parse(text: str | bytes) -> Target | PlayTrajectory | SwitchController | Reb
         raise BadMessage(f"message too long ({size} bytes, at most {MAX_MESSAGE_BYTES})")
     try:
         message = json.loads(text)
-    except (ValueError, UnicodeDecodeError):
+    except (ValueError, UnicodeDecodeError, RecursionError):  # RecursionError: "[[[[..." nested past the stack
         raise BadMessage("message is not JSON") from None
     if not isinstance(message, dict):
         raise BadMessage("message must be a JSON object")

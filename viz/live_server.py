@@ -21,14 +21,12 @@ import dataclasses
 import importlib.resources
 import json
 import math
-import os
 import pathlib
 import signal
 import sys
 import threading
 import time
 import urllib.parse
-from collections.abc import Callable
 
 import mujoco
 import numpy as np
@@ -303,8 +301,8 @@ class LiveSession:
         return state
 
     def write_html(self, path: pathlib.Path) -> None:
-        """The current model's run as a recording, written whole (a temporary file, then renamed)."""
-        tmp = path.with_name(path.name + ".tmp")
+        """The current model's run as a recording at ``path`` (``twin view`` stages it, so that it is
+        written whole or not at all)."""
         rows = [self.recorder.trace_rows()]
         if self.joints.second is not None:
             rows.append(self.recorder.trace_rows(compare=True))
@@ -313,8 +311,7 @@ class LiveSession:
         title = f"live: {runs}; {s.payload * 1e3:g} g {s.orientation.value} ({s.plant_name}, seed {s.seed})"
         if self.compare is not None:
             title += f" vs {compare_label(self.compare.text)}"
-        write_page(tmp, scenes=self.scenes, frames=self.recorder.frames, rows=rows, title=title)
-        os.replace(tmp, path)
+        write_page(path, scenes=self.scenes, frames=self.recorder.frames, rows=rows, title=title)
 
 
 def _packed(commands: list[dict]) -> list[bytes]:
@@ -336,7 +333,10 @@ def _host_allowed(handler: tornado.web.RequestHandler, viewer: LiveViewer) -> bo
     """Bound to loopback, answer only requests addressed to loopback (no DNS rebinding)."""
     if viewer.host not in ("127.0.0.1", "::1", "localhost"):
         return True
-    return urllib.parse.urlsplit("//" + handler.request.host).hostname in LOOPBACK_HOSTS
+    try:
+        return urllib.parse.urlsplit("//" + handler.request.host).hostname in LOOPBACK_HOSTS
+    except ValueError:  # a Host that is no host ("[::1"): not addressed to loopback
+        return False
 
 
 class _PageHandler(tornado.web.RequestHandler):
@@ -387,9 +387,8 @@ class _SocketHandler(tornado.websocket.WebSocketHandler):
 class LiveViewer:
     """The server and the clock; ``start()`` serves until :meth:`stop` or Ctrl-C."""
 
-    def __init__(self, session: LiveSession, *, host: str = "127.0.0.1", port: int = 7000, speed: float = 1.0,
-                 on_frame: Callable[[], None] | None = None):
-        self.session, self.speed, self.on_frame = session, speed, on_frame
+    def __init__(self, session: LiveSession, *, host: str = "127.0.0.1", port: int = 7000, speed: float = 1.0):
+        self.session, self.speed = session, speed
         self.clients: set[_SocketHandler] = set()
         app = tornado.web.Application([
             (r"/", _PageHandler, {"viewer": self}), (r"/meshcat.js", _ScriptHandler, {"script": MESHCAT_SCRIPT}),
@@ -454,17 +453,18 @@ class LiveViewer:
         readout = json.dumps(self.session.readout())  # drains the samples, shown or not
         if self.clients:
             self.broadcast([*_packed(frame_commands(self.session.frame())), readout], droppable=True)
-        if self.on_frame is not None:
-            self.on_frame()
 
-    def start(self) -> None:
-        """Serve until :meth:`stop`, :meth:`shutdown`, or (on the main thread) SIGINT/SIGTERM, which
+    def start(self, *, stop_after: float | None = None) -> None:
+        """Serve until :meth:`stop`, :meth:`shutdown`, ``stop_after`` seconds (then a shutdown, whether
+        the simulation still runs or has failed), or (on the main thread) SIGINT/SIGTERM, which
         shut down: the pages are told that the twin stopped before their sockets close."""
         self.server.add_sockets(self.sockets)
         self._last = time.perf_counter()
         self.loop = tornado.ioloop.IOLoop.current()
         self.clock = tornado.ioloop.PeriodicCallback(self._tick, 1000.0 / FRAME_RATE)
         self.clock.start()
+        if stop_after is not None:
+            self.loop.call_later(stop_after, self.shutdown)
         previous = {}
         if threading.current_thread() is threading.main_thread():
             for number in (signal.SIGINT, signal.SIGTERM):

@@ -129,6 +129,17 @@ def test_toml_grid(tmp_path):
     assert axes == {"controller": ["smc"], "payload": [0.0, 6.75, 13.5], "seed": [0, 1]}
 
 
+@pytest.mark.parametrize("config, complaint", [
+    ('seed = [0, 1, 2]\ntrajectory = [2]\n[grid]\nseed = [1]\n', "not both (found seed, trajectory beside [grid])"),
+    ('supply_kpa = [300]\nsupply-kpa = [400]\n', "the axis supply_kpa is given twice ('supply-kpa'"),
+])
+def test_a_config_whose_axes_would_be_dropped_is_refused(tmp_path, config, complaint):
+    """Until stop 60 the keys beside [grid], and one of two spellings of an axis, were ignored silently."""
+    (tmp_path / "g.toml").write_text(config)
+    with pytest.raises(InvalidScenario, match=re.escape(complaint)):
+        grid.read_toml(tmp_path / "g.toml")
+
+
 @pytest.mark.parametrize("config, bad", [(None, "missing.toml"), ('[grid]\nseed = [0, 1\n', "bad.toml"),
                                          ('grid = 3\n', "bad.toml")])
 def test_an_unreadable_config_is_an_invalid_scenario_naming_the_file(tmp_path, config, bad):

@@ -342,23 +342,32 @@ def _tmpfs(folder: pathlib.Path, size: str):
         subprocess.run(["umount", str(folder)], check=True)
 
 
-def _after_disk_full(capsys, folder: pathlib.Path, code: int) -> list[str]:
-    """Exit 2 and, last on stderr (after any progress bar), one line saying the disk is full; what is left
-    in ``folder``."""
+def _after_disk_full(capsys, folder: pathlib.Path, code: int, *, named: pathlib.Path | None = None) -> list[str]:
+    """Exit 2 and, last on stderr (after any progress bar), one line saying the disk is full (and, if
+    given, that ``named`` cannot be written); what is left in ``folder``."""
     assert code == 2
     err = capsys.readouterr().err
     errors = [line for line in err.splitlines() if line.startswith("twin: error:")]
     assert len(errors) == 1 and err.rstrip().endswith(errors[0]) and "Traceback" not in err, err
     assert "No space left on device" in errors[0], errors[0]
+    assert named is None or f"cannot write {named}: " in errors[0], errors[0]
     return sorted(p.name for p in folder.iterdir()) if folder.exists() else []
 
 
-@pytest.mark.parametrize("size", ["128k", "240k"])  # full in the trace (205 KB), full in the plot (55 KB)
-def test_a_full_disk_leaves_no_output_of_twin_run(tmp_path, capsys, size):
+@pytest.mark.parametrize("size, full", [("128k", "t.csv"), ("240k", "t.png")])  # trace 205 KB, plot 55 KB
+def test_a_full_disk_leaves_no_output_of_twin_run(tmp_path, capsys, size, full):
     with _tmpfs(tmp_path / "disk", size) as disk:
         code = main(["run", "--controller", "ffpva", "--trajectory", "1", "--trace", str(disk / "t.csv"),
                      "--plot", str(disk / "t.png")])
-        assert _after_disk_full(capsys, disk, code) == []  # neither output, nor a temporary
+        assert _after_disk_full(capsys, disk, code, named=disk / full) == []  # neither output, nor a temporary
+
+
+def test_a_full_disk_leaves_no_part_of_a_live_recording(tmp_path, capsys):
+    """``twin view --html`` left its temporary (the disk's whole 64 KB) and named no file until stop 60."""
+    with _tmpfs(tmp_path / "disk", "64k") as disk:
+        code = main(["view", "--controller", "ffpva", "--trajectory", "1", "--port", "0", "--duration", "1",
+                     "--html", str(disk / "v.html")])
+        assert _after_disk_full(capsys, disk, code, named=disk / "v.html") == []
 
 
 def test_a_disk_that_fills_while_the_trace_is_written_leaves_no_output_of_twin_run(tmp_path, capsys, monkeypatch):
@@ -1398,3 +1407,65 @@ def test_a_stop_python_swallowed_in_a_forked_sweep_stops_it_after_that_batch(tmp
         assert len(store.done()) == calls[0]
     finally:
         store.close()
+
+
+def _must_not_run(*args, **kwargs):
+    raise AssertionError("the work ran before the outputs were checked")
+
+
+@pytest.mark.parametrize("command, in_the_way, work", [
+    (["calibrate"], "as_built.json", ("twin.experiments.calibrate", "calibrate")),  # a finished fit was lost
+    (["sweep", "--seed", "0"], "summary.csv", ("twin.batch.sweep", "run_sweep")),  # found once the grid had run
+    (["demo", "--no-plots"], "results.csv", ("twin.experiments.demo", "run_demo")),
+])
+def test_a_folder_in_the_way_of_an_output_is_found_before_the_work(tmp_path, capsys, monkeypatch, command,
+                                                                   in_the_way, work):
+    """Until stop 60 these three found it only when the results went into place: a calibration's whole fit
+    (5-12 min) was lost, a sweep's grid ran first."""
+    module, name = work
+    monkeypatch.setattr(__import__(module, fromlist=[name]), name, _must_not_run)
+    out = tmp_path / "out"
+    (out / in_the_way).mkdir(parents=True)
+    assert main([*command, "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err == f"twin: error: cannot write {out / in_the_way}: a folder is in the way of this file"
+    assert sorted(p.name for p in out.iterdir()) == [in_the_way]
+
+
+@pytest.mark.parametrize("command, other, summary, first_line", [
+    (["sweep", "--seed", "0"], "demo", "summary.md", "# Thesis controller comparison on the twin ('thesis' plant)\n"),
+    (["demo", "--no-plots"], "sweep", "summary.csv", None),
+])
+def test_demo_and_sweep_refuse_each_others_folder_which_they_would_half_overwrite(tmp_path, capsys, monkeypatch,
+                                                                                   command, other, summary, first_line):
+    """Both write results.csv; a sweep into a demo's folder replaced it and left the demo's summary.md
+    describing other runs (found by probing, stop 60)."""
+    from twin.batch.tables import SUMMARY_COLUMNS
+
+    monkeypatch.setattr(__import__("twin.batch.sweep", fromlist=["run_sweep"]), "run_sweep", _must_not_run)
+    monkeypatch.setattr(__import__("twin.experiments.demo", fromlist=["run_demo"]), "run_demo", _must_not_run)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "results.csv").write_text("theirs\n")
+    (out / summary).write_text(first_line or ",".join(SUMMARY_COLUMNS) + "\n")
+    assert main([*command, "--out", str(out)]) == 2
+    assert capsys.readouterr().err.strip() == (f"twin: error: --out {out} holds twin {other}'s results ({summary}): "
+                                               f"give twin {command[0]} a folder of its own")
+    assert (out / "results.csv").read_text() == "theirs\n"
+    (out / summary).write_text("# my own notes\n")  # a summary of the user's own is no other command's
+    with pytest.raises(AssertionError, match="before the outputs were checked"):
+        main([*command, "--out", str(out)])
+
+
+@pytest.mark.parametrize("command", [["sweep", "--seed", "0"], ["whatif", "payload", "--payloads", "0", "--seeds", "1"]])
+def test_a_command_whose_store_cannot_be_made_leaves_no_folder(tmp_path, capsys, command):
+    """A full disk where the store is made: nothing ran, so a folder made here goes, as for refused input
+    (it stayed, with a lock and a broken store, until stop 60)."""
+    with _tmpfs(tmp_path / "disk", "64k") as disk:
+        code = main([*command, "--out", str(disk / "out")])
+        assert code == 2
+        err = capsys.readouterr().err
+        errors = [line for line in err.splitlines() if line.startswith("twin: error:")]
+        assert len(errors) == 1 and err.rstrip().endswith(errors[0]), err
+        assert errors[0].startswith("twin: error: cannot write the results store"), err
+        assert list(disk.iterdir()) == []

@@ -16,7 +16,7 @@ from controllers import make_controller
 from controllers.feedforward import NominalModel
 from controllers.policy import ControllerPolicy
 from twin.envs import environment as joint_env
-from twin.envs.runner import run
+from twin.envs.runner import run, thesis_controllers
 from twin.exceptions import InvalidScenario
 from twin.physics.model import Orientation
 from twin.sim.scenario import Scenario
@@ -73,6 +73,31 @@ def test_thesis_controllers_as_policies_match_twin_run(name, trajectory, load):
     assert rmse == reference.metrics.rmse
     n = len(reference.trace.angle)
     np.testing.assert_array_equal(environment.physics.true_angle[:n], reference.trace.angle)
+
+
+def test_on_as_built_the_episode_rmse_scores_the_hall_reading_as_twin_run_does():
+    """``as-built`` scores its Hall reading (calibration error and noise), as the rig's runs were; the
+    environment's RMSE read the true angle there until stop 60 (2.73 against twin run's 1.54 deg)."""
+    scenario = Scenario("ffpva", 1, seed=3, plant="as-built")
+    controller = thesis_controllers([scenario])[0]
+    environment = joint_env.load("track", trajectory=1, action_period=controller.period, seed=3,
+                                 controller="ffpva", plant="as-built")
+    rmse = _episode(environment, ControllerPolicy(controller, spur_radius=scenario.preset.params.gears.spur_radius))
+    reference = run(scenario)
+    n = len(reference.trace.angle)
+    np.testing.assert_array_equal(environment.physics.true_angle[:n], reference.trace.angle)
+    np.testing.assert_array_equal(environment.physics.measured_position[:n], reference.trace.measured_position)
+    assert rmse == reference.metrics.rmse
+    assert abs(rmse - float(np.sqrt(np.mean((reference.trace.desired_angle - reference.trace.angle) ** 2)))) > 1e-3
+
+
+def test_the_episode_rmse_before_the_episode_has_run_is_refused():
+    environment = joint_env.load("track", trajectory=1, seed=0)
+    environment.reset()
+    for _ in range(10):
+        environment.step([0.0])
+    with pytest.raises(InvalidScenario, match="needs its whole 3 s; 0.16 s have run"):
+        environment.physics.episode_rmse()
 
 
 @pytest.mark.slow  # over ~2.5 s on 2 cores (measured 2026-11-26)

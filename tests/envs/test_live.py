@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import base64
+import http.client
 import json
 import math
 import threading
@@ -94,6 +95,7 @@ def test_noise_blocks_continue_deterministically(monkeypatch):
     ('{"type": "controller", "name": "pid"}', "pva, ffpva, smc"),
     ('{"type": "orientation", "value": "upside-down"}', "horizontal, vertical"),
     ('{"type": "target", "angle_deg": 1' + " " * 2000 + "}", "too long"),
+    ("[" * 1024, "not JSON"),  # nested past the parser's stack: "cannot apply that: RecursionError" until stop 60
 ])
 def test_bad_messages_are_refused_with_a_reason(text, complaint):
     with pytest.raises(live_messages.BadMessage, match=None) as caught:
@@ -283,6 +285,29 @@ def test_server_listens_on_loopback_only_by_default():
     assert listening == {"127.0.0.1"}
 
 
+def test_a_request_not_addressed_to_loopback_is_refused_and_a_malformed_host_too():
+    """No DNS rebinding: bound to loopback, the server answers only a Host naming loopback. A Host that
+    is no host ("[::1") was a 500 with a traceback until stop 60; it is refused as any foreign one."""
+    server = _ServerThread(Scenario("ffpva", 1, seed=0))
+    port = server.viewer.port
+    try:
+        statuses = {}
+        for host in (f"localhost:{port}", f"127.0.0.1:{port}", "rebound.example", "[::1"):
+            for path in ("/", "/ws"):
+                connection = http.client.HTTPConnection("127.0.0.1", port, timeout=10)
+                connection.putrequest("GET", path, skip_host=True)
+                connection.putheader("Host", host)
+                connection.endheaders()
+                statuses[host, path] = connection.getresponse().status
+                connection.close()
+    finally:
+        server.stop()
+    assert statuses[f"localhost:{port}", "/"] == statuses[f"127.0.0.1:{port}", "/"] == 200
+    assert statuses[f"localhost:{port}", "/ws"] == 400  # a plain GET: not a websocket upgrade, yet let in
+    assert {statuses["rebound.example", p] for p in ("/", "/ws")} == {403}
+    assert {statuses["[::1", p] for p in ("/", "/ws")} == {403}
+
+
 def test_a_taken_port_is_a_clear_error():
     server = _ServerThread(Scenario("ffpva", 1, seed=0))
     try:
@@ -389,6 +414,28 @@ def test_a_failing_simulation_stops_once_and_tells_the_page():
             sock.close()
     assert stopped == [True] and viewer.failure == "simulation stopped: boom"
     assert json.loads(sent[0]) == {"type": "error", "message": "simulation stopped: boom"}
+
+
+def test_a_viewer_told_to_stop_after_some_seconds_stops_though_its_simulation_failed():
+    """``twin view --duration``: until stop 60 the duration was checked after each frame, and a failed
+    simulation draws none, so the server served on for ever."""
+    session = LiveSession(Scenario("ffpva", 1, seed=0))
+
+    def broken(duration):
+        raise RuntimeError("boom")
+
+    session.advance = broken
+    ended = threading.Event()
+
+    def serve():
+        asyncio.set_event_loop(asyncio.new_event_loop())
+        viewer = LiveViewer(session, port=0)
+        viewer.start(stop_after=0.5)
+        ended.set()
+
+    thread = threading.Thread(target=serve, daemon=True)
+    thread.start()
+    assert ended.wait(30)  # 0.5 s and the shutdown's grace
 
 
 def test_rebuilds_are_rate_limited_and_state_says_what_plays(monkeypatch):

@@ -136,9 +136,20 @@ def read_toml(path) -> dict[str, list]:
     table = data.get("grid", data)
     if not isinstance(table, dict):
         raise InvalidScenario(f"--config {str(path)!r}: [grid] must be a table of axes")
+    if table is not data and len(data) > 1:  # keys beside [grid] were ignored silently until stop 60
+        beside = sorted(key for key in data if key != "grid")
+        raise InvalidScenario(f"--config {str(path)!r}: axes go either at the top or under [grid], not both "
+                              f"(found {', '.join(beside)} beside [grid])")
     if not table:
         raise InvalidScenario(f"--config {str(path)!r} names no axes: give at least one, e.g. seed = [0, 1, 2]")
-    return {key.replace("-", "_"): parse_axis(key.replace("-", "_"), value) for key, value in table.items()}
+    axes: dict[str, list] = {}
+    for key, value in table.items():
+        name = key.replace("-", "_")
+        if name in axes:  # supply_kpa and supply-kpa: one was dropped silently until stop 60
+            raise InvalidScenario(f"--config {str(path)!r}: the axis {name} is given twice ({key!r} and its other "
+                                  "spelling)")
+        axes[name] = parse_axis(name, value)
+    return axes
 
 
 @dataclasses.dataclass(frozen=True)

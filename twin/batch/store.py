@@ -27,27 +27,32 @@ class StoreUnwritable(TwinError):
     """The results store cannot be created or written where asked."""
 
 
+class StoreNotMade(StoreUnwritable):
+    """The results store could not even be opened or made: it holds no finished run."""
+
+
 class ResultStore:
     def __init__(self, path: pathlib.Path, *, version: str):
         self.path = path
+        self._db: sqlite3.Connection | None = None
         try:
             self._db = sqlite3.connect(path)
             foreign = self._foreign_tables()
             if foreign:
-                self._db.close()
                 raise StaleStore(f"{path} is not a results store of this twin (it holds a table {foreign!r} that "
                                  "this store does not make): use a new --out folder")
             self._db.execute("PRAGMA journal_mode=WAL")
             with self._db:
                 self._db.execute(f"CREATE TABLE IF NOT EXISTS results ({', '.join(COLUMNS)}, PRIMARY KEY (key))")
                 self._db.execute("CREATE TABLE IF NOT EXISTS meta (name TEXT PRIMARY KEY, value TEXT)")
-        except sqlite3.Error as error:  # a folder that exists but cannot be written, a full disk, a broken file
-            raise StoreUnwritable(f"cannot write the results store {path}: {error}") from None
-        try:
             self._claim(version)
-        except StaleStore:
-            self._db.close()
-            raise
+        except (sqlite3.Error, StaleStore) as error:  # closed: a store refused holds no file open
+            if self._db is not None:
+                self._db.close()
+            if isinstance(error, StaleStore):
+                raise
+            # a folder that exists but cannot be written, a full disk, a broken file
+            raise StoreNotMade(f"cannot write the results store {path}: {error}") from None
 
     def _foreign_tables(self) -> str | None:
         """The first table the file holds that this store would not make (another name, or ``results`` or

@@ -11,7 +11,7 @@ from twin.batch.tables import counted
 from twin.cli.common import output_folder
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
-from twin.experiments.base import staged, tell_undrawn
+from twin.experiments.base import refuse_folders_in_the_way, staged, tell_undrawn
 
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
@@ -28,6 +28,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
         print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
 
+    refuse_folders_in_the_way(args.out, [calibrate.FILE_NAME, "calibration.png"])  # now, not after the fit
     with output_folder(args.out) as folder:
         print(f"calibrate: {counted(calibrate.planned_evaluations(), 'evaluation')} at most, on "
               f"{counted(args.workers, 'worker')}; a line for each once the workers have started",

@@ -213,10 +213,28 @@ def output_folder(out: pathlib.Path, *, keep_on_failure: bool = False):
         raise
 
 
+def refuse_another_commands_folder(out: pathlib.Path, command: str) -> None:
+    """``twin demo`` and ``twin sweep`` both write ``results.csv``: each refuses a folder that holds the other's
+    results (found by the summary only that one writes, by its first words), which it would overwrite in
+    part, leaving the rest to describe other runs."""
+    from twin.batch.tables import SUMMARY_COLUMNS
+    from twin.experiments.demo import SUMMARY_TITLE
+
+    summaries = {"demo": ("summary.md", SUMMARY_TITLE), "sweep": ("summary.csv", ",".join(SUMMARY_COLUMNS))}
+    for other, (name, first_words) in summaries.items():
+        path = out / name
+        if other != command and path.is_file():
+            with open(path, errors="replace") as handle:
+                if handle.read(len(first_words)) == first_words:
+                    raise InvalidScenario(f"--out {out} holds twin {other}'s results ({name}): give twin {command} "
+                                          "a folder of its own")
+
+
 @contextlib.contextmanager
 def all_or_nothing(paths: list[pathlib.Path]):
     """Temporary files beside ``paths`` (same folder, same suffix) to write into; each becomes its path
-    only once every one was written, and none is left behind if any write fails."""
+    only once every one was written, and none is left behind if any write fails. An OSError that names a
+    temporary names its path instead (write each inside :func:`naming` so that a full disk's names one)."""
     temporary = [path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}") for path in paths]
     try:
         yield temporary
@@ -229,6 +247,18 @@ def all_or_nothing(paths: list[pathlib.Path]):
     finally:
         for tmp in temporary:
             tmp.unlink(missing_ok=True)
+
+
+@contextlib.contextmanager
+def naming(path: pathlib.Path):
+    """An OSError of the block that names no file (a write's own: a full disk) names ``path``, so that its
+    one-line error says which output could not be written."""
+    try:
+        yield
+    except OSError as error:
+        if error.filename is not None:
+            raise
+        raise OSError(error.errno, error.strerror, str(path)) from None
 
 
 def say_written(paths: list[pathlib.Path]) -> None:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import argparse
 import sys
 
+from twin.batch.store import StoreNotMade
 from twin.cli.common import EXIT_INTERRUPTED, Parser, output_folder
 from twin.experiments import arguments
 from twin.experiments.base import Experiment, refuse_folders_in_the_way, tell_undrawn
@@ -20,9 +21,12 @@ def run_experiment(experiment: Experiment, args: argparse.Namespace) -> int:
     experiment is resumable (its store may hold finished runs, whatever stopped it)."""
     experiment.check(args)  # bad input: a one-line error before anything is written
     refuse_folders_in_the_way(args.out, experiment.file_names())  # staged() checks what it wrote again
-    with output_folder(args.out, keep_on_failure=experiment.resumable):
+    with output_folder(args.out, keep_on_failure=experiment.resumable) as folder:
         try:
             outcome = experiment.run(args, args.out)
+        except StoreNotMade:  # no run finished: a folder made here goes, as for refused input
+            folder.keep = False
+            raise
         except KeyboardInterrupt:
             if not experiment.resumable:
                 raise

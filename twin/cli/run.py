@@ -10,6 +10,7 @@ from twin.cli.common import (
     all_or_nothing,
     compare_of,
     compare_settings,
+    naming,
     say_written,
     scenario_from,
 )
@@ -33,16 +34,19 @@ def _cmd_run(args: argparse.Namespace) -> int:
     with all_or_nothing(outputs) as temporary:  # every output, or none (a failed one leaves no other)
         staged = dict(zip(outputs, temporary, strict=True))
         if args.trace:
-            report.write_trace(result, staged[args.trace])
+            with naming(staged[args.trace]):
+                report.write_trace(result, staged[args.trace])
         if args.plot:
             from viz.plots import plot_run
 
-            plot_run(result, staged[args.plot])
+            with naming(staged[args.plot]):
+                plot_run(result, staged[args.plot])
         if args.html:
             from viz.recording import write_recording
 
-            write_recording(result, staged[args.html], compare=compared,
-                            compare_text=None if compared is None else args.compare)
+            with naming(staged[args.html]):
+                write_recording(result, staged[args.html], compare=compared,
+                                compare_text=None if compared is None else args.compare)
     say_written(outputs)
     record = report.summary(result)
     if args.json:

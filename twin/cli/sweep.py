@@ -8,10 +8,10 @@ import os
 import pathlib
 import sys
 
-from twin.cli.common import EXIT_INTERRUPTED, output_folder
+from twin.cli.common import EXIT_INTERRUPTED, output_folder, refuse_another_commands_folder
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
-from twin.experiments.base import staged, tell_undrawn
+from twin.experiments.base import refuse_folders_in_the_way, staged, tell_undrawn
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
@@ -37,11 +37,16 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     address = args.ray_address or os.environ.get("RAY_ADDRESS")
     if args.backend == "ray" and address:
         check_ray_address(address, "--ray-address" if args.ray_address else "RAY_ADDRESS")
+    refuse_folders_in_the_way(args.out, OUTPUTS)  # now, not once the grid has run
+    refuse_another_commands_folder(args.out, "sweep")
     # one writer per folder (a second sweep into it is refused, naming this one); SIGTERM stops it as Ctrl-C
-    # does; the folder stays whatever stops the sweep: its store keeps the finished scenarios
-    with output_folder(args.out, keep_on_failure=True) as folder:
-        from twin.batch.sweep import ClusterNotStarted
+    # does; once its store is open the folder stays whatever stops the sweep: the store keeps the finished
+    # scenarios (a store that cannot be made, on a full disk, leaves no folder made here)
+    with output_folder(args.out) as folder:
+        from twin.batch.sweep import ClusterNotStarted, open_store
 
+        open_store(args.out).close()  # refuses a store of another code version before any output
+        folder.keep = True
         try:
             return _sweep(args, points)
         except ClusterNotStarted:
@@ -69,13 +74,15 @@ def check_ray_address(address: str, source: str = "--ray-address") -> None:
         raise InvalidScenario(f"{source}: cannot reach a Ray cluster at {address} ({error.strerror or error})") from None
 
 
+OUTPUTS = ("results.csv", "results.parquet", "summary.csv", "rmse.png")  # the figure last
+
+
 def _sweep(args: argparse.Namespace, points: list) -> int:
     from tqdm import tqdm
 
     from twin.batch import tables
-    from twin.batch.sweep import counting, open_store, run_sweep
+    from twin.batch.sweep import counting, run_sweep
 
-    open_store(args.out).close()  # refuses a store of another code version before any output
     print(f"{len(points)} scenario{'' if len(points) == 1 else 's'} -> {args.out.resolve()}", file=sys.stderr)
     bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
     try:
@@ -97,8 +104,8 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
     with staged(args.out, "sweep") as stage:
         tables.write_results(outcome.records, stage.folder)
         tables.write_summary(summary, stage.folder)
-        stage.names += ["results.csv", "results.parquet", "summary.csv"]
-        stage.figure("rmse.png", lambda path: plot_summary(summary, path))
+        stage.names += list(OUTPUTS[:-1])
+        stage.figure(OUTPUTS[-1], lambda path: plot_summary(summary, path))
     print(tables.format_summary(summary))
     failed = [r for r in outcome.records if r["status"] != "ok"]
     for r in failed[:20]:
@@ -111,9 +118,13 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
 
 def add_parser(sub) -> None:
     sweep = sub.add_parser("sweep", help="a grid of scenarios on all cores (or Ray), resumable")
-    for name in ("controller", "trajectory", "payload", "orientation", "plant", "seed", "supply_kpa", "pwm_period_ms"):
+    axes = {"controller": "pva, ffpva, smc", "trajectory": "1-4", "payload": "grams at the tip",
+            "orientation": "horizontal, vertical", "plant": "preset names", "seed": "noise seeds; also a-b",
+            "supply_kpa": "supply pressures (kPa)", "pwm_period_ms": "PWM periods (ms)"}
+    for name, what in axes.items():
+        numbers = "" if name in ("controller", "orientation", "plant") else "; also start:stop:step"
         sweep.add_argument("--" + name.replace("_", "-"), dest=name, metavar="LIST",
-                           help="comma list; numbers also start:stop:step; seeds also a-b")
+                           help=f"comma list of {what}{numbers}")
     sweep.add_argument("--config", type=pathlib.Path, metavar="GRID.toml", help="axes from a TOML file")
     sweep.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="results folder (created)")
     sweep.add_argument("--workers", type=arguments.positive_int, default=None,

@@ -4,14 +4,15 @@ from __future__ import annotations
 
 import argparse
 import sys
-import time
 
 from twin.batch.stops import raise_if_stopped
 from twin.cli.common import (
     EXIT_INTERRUPTED,
     add_scenario_arguments,
+    all_or_nothing,
     compare_of,
     compare_settings,
+    naming,
     scenario_from,
     sigterm_as_interrupt,
 )
@@ -27,20 +28,18 @@ def _cmd_view(args: argparse.Namespace) -> int:
     if args.host not in ("127.0.0.1", "localhost", "::1"):
         print(f"warning: serving on {args.host}: anyone who can reach it can drive the twin", file=sys.stderr)
     print(f"twin view: open {viewer.url}  (Ctrl-C to stop)", flush=True)
-    if args.duration is not None:
-        stop_at = time.monotonic() + args.duration
-        viewer.on_frame = lambda: viewer.shutdown() if time.monotonic() >= stop_at else None
     raise_if_stopped()  # one swallowed while the model was built: stop before serving (serving takes a stop itself)
     with sigterm_as_interrupt():  # stop (and write --html) on SIGTERM too
         try:
-            viewer.start()
+            viewer.start(stop_after=args.duration)
         except KeyboardInterrupt:
             viewer.stop()
         print("twin view: stopped", flush=True)
         if args.html is not None:
             print(f"writing {args.html} ...", flush=True)
             try:
-                session.write_html(args.html)
+                with all_or_nothing([args.html]) as (staged,), naming(staged):  # a full disk leaves none of it
+                    session.write_html(staged)
             except KeyboardInterrupt:
                 print("twin view: interrupted; no recording written", file=sys.stderr)
                 return EXIT_INTERRUPTED

@@ -56,8 +56,10 @@ from twin.exceptions import InvalidAction, InvalidScenario
 from twin.physics.model import THESIS_PAYLOADS, Orientation, build_mjcf, compile_joint
 from twin.physics.ticks import whole_ticks
 from twin.physics.trajectories import Reference, Segment, Trajectory, trajectory
+from twin.sim.metrics import tracking_metrics
 from twin.sim.plant_state import PlantState, place_on_manifold, true_start
 from twin.sim.scenario import Scenario
+from twin.sim.simulation import scored
 from twin.sim.tick import Ticker
 
 TASKS = ("track", "hold")
@@ -109,6 +111,7 @@ class JointPhysics(dm_mujoco.Physics):
         self.ticker.sense()
         self.true_angle = np.zeros(ticks + 1)
         self.true_angle[0] = self.data.qpos[self.joint.spur_dof]
+        self.measured_position = np.zeros(ticks)  # m, the Hall reading each tick acted on
 
     @property
     def k(self) -> int:
@@ -124,6 +127,7 @@ class JointPhysics(dm_mujoco.Physics):
         for _ in range(nstep):
             if self.k >= self.ticks:
                 raise InvalidScenario("the episode is over: reset the environment")
+            self.measured_position[self.k] = self.ticker.sense().position[0]  # act() uses this same sample
             self.ticker.act(self.duty)
             self.true_angle[self.k] = self.data.qpos[self.joint.spur_dof]
 
@@ -139,10 +143,16 @@ class JointPhysics(dm_mujoco.Physics):
         return self.desired_angle() - float(self.true_angle[self.k])
 
     def episode_rmse(self) -> float:
-        """RMSE (rad) of the true angle over the episode's reference duration, as ``twin run`` reports it."""
+        """RMSE (rad) over the episode's reference duration, as ``twin run`` reports it: of the angle its
+        plant scores (the Hall reading on ``as-built``, the true angle on ``thesis``). Only once the
+        episode has run that long (InvalidScenario before: the ticks not yet run have no angle)."""
         n = int(round(self.episode.trajectory.duration / self.timestep()))
+        if self.k < n:
+            raise InvalidScenario(f"the episode's RMSE needs its whole {n * self.timestep():g} s; "
+                                  f"{self.k * self.timestep():g} s have run")
         desired = self.reference.position[:n] / self.spur_radius
-        return float(np.sqrt(np.mean((desired - self.true_angle[:n]) ** 2)))
+        angle = scored(self.true_angle[:n], self.measured_position[:n], self.episode.scenario.preset)
+        return tracking_metrics(desired, angle).rmse
 
 
 class JointTask(base.Task):

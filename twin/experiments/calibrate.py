@@ -558,7 +558,10 @@ def record(result: Calibration) -> dict:
     }
 
 
-def write(data: dict, out: pathlib.Path, name: str = "as_built.json") -> pathlib.Path:
+FILE_NAME = "as_built.json"  # what a fit writes in --out (and, installed, the as-built preset's name)
+
+
+def write(data: dict, out: pathlib.Path, name: str = FILE_NAME) -> pathlib.Path:
     """``data`` as ``out/name``, whole or not at all: written beside it, then renamed over it (an
     earlier file stays as it was if the write fails)."""
     path = out / name

@@ -103,6 +103,7 @@ RUN_FIGURE = re.compile(rf"({'|'.join(CONTROLLER_NAMES)})_T[1-4]_seed\d+\.png") 
 
 
 SUMMARY_TITLE = "# Thesis controller comparison on the twin"  # summary.md's first words: a demo wrote the folder
+OUTPUTS = ("results.csv", "summary.md")  # besides the figures
 
 
 def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
@@ -133,7 +134,7 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
                     writer.writeheader()
                 writer.writerow(record)
         (stage.folder / "summary.md").write_text(f"{SUMMARY_TITLE} ('thesis' plant, {counted(seeds, 'seed')})\n\n{table}\n")
-        stage.names += ["results.csv", "summary.md"]
+        stage.names += list(OUTPUTS)
         if plots:
             from viz.plots import plot_run
 

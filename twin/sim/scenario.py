@@ -6,6 +6,8 @@ import dataclasses
 import math
 import numbers
 
+import numpy as np
+
 from twin.exceptions import InvalidScenario
 from twin.physics.model import MAX_PAYLOAD, Orientation
 from twin.plants import Plant, plant
@@ -15,6 +17,16 @@ CONTROLLER_LABELS = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mo
 MODEL_BASED_CONTROLLERS = ("ffpva", "smc")  # the two with the feed-forward model (§6)
 TRAJECTORY_NUMBERS = (1, 2, 3, 4)
 MAX_SEED = 2**63 - 1  # the largest noise seed a run's results can be stored with (SQLite's INTEGER)
+
+
+def _finite(value) -> bool:
+    """A finite real number, not a truth value (True == 1) nor text; an int past a float's range is not finite."""
+    if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
+        return False
+    try:
+        return math.isfinite(value)
+    except OverflowError:  # 10**400
+        return False
 
 
 @dataclasses.dataclass(frozen=True)
@@ -35,28 +47,35 @@ class Scenario:
         if isinstance(self.trajectory, bool) or not isinstance(self.trajectory, numbers.Integral) \
                 or self.trajectory not in TRAJECTORY_NUMBERS:  # True == 1 and 1.0 == 1: not trajectories
             raise InvalidScenario(f"unknown trajectory {self.trajectory!r}: choose 1, 2, 3 or 4")
-        if not isinstance(self.payload, numbers.Real) or not math.isfinite(self.payload) \
-                or not 0 <= self.payload <= MAX_PAYLOAD:
-            shown = f"{self.payload * 1e3:g} g" if isinstance(self.payload, numbers.Real) else repr(self.payload)
+        if not _finite(self.payload) or not 0 <= self.payload <= MAX_PAYLOAD:
+            try:
+                shown = repr(self.payload) if isinstance(self.payload, bool) else f"{self.payload * 1e3:.10g} g"
+            except (TypeError, OverflowError):  # text; an int past a float's range
+                shown = repr(self.payload)
             raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, got {shown}")
         if not isinstance(self.orientation, Orientation):
             raise InvalidScenario(f"orientation must be an Orientation, got {self.orientation!r}")
         if self.pwm_period is not None:
             base = self.plant if isinstance(self.plant, Plant) else plant(self.plant)
+            if not _finite(self.pwm_period):
+                raise InvalidScenario(f"PWM period must be a number of seconds, got {self.pwm_period!r}")
             ticks = self.pwm_period / base.timestep
-            if not math.isfinite(self.pwm_period) or self.pwm_period <= 0 or abs(ticks - round(ticks)) > 1e-9 \
-                    or not 4 <= round(ticks) <= 100:
+            if self.pwm_period <= 0 or abs(ticks - round(ticks)) > 1e-9 or not 4 <= round(ticks) <= 100:
                 raise InvalidScenario(f"PWM period must be a whole number of {base.timestep * 1e3:g} ms ticks "
-                                      f"between 4 and 100 ticks, got {self.pwm_period * 1e3:g} ms")
+                                      f"between 4 and 100 ticks, got {self.pwm_period * 1e3:.10g} ms")
         preset = self.preset
         if not isinstance(self.seed, numbers.Integral) or isinstance(self.seed, bool) or not 0 <= self.seed <= MAX_SEED:
             raise InvalidScenario(f"seed must be an integer from 0 to 2^63 - 1, got {self.seed!r}")
+        if not isinstance(self.noise, bool | np.bool_):  # "off" is truthy: it would run with the noise on
+            raise InvalidScenario(f"noise must be True or False, got {self.noise!r}")
         if self.supply_pressure is not None:
             rated = preset.params.cylinder.rated_pressure
-            if not math.isfinite(self.supply_pressure) or not 0 < self.supply_pressure <= rated:
+            if not _finite(self.supply_pressure):
+                raise InvalidScenario(f"supply pressure must be a number of Pa, got {self.supply_pressure!r}")
+            if not 0 < self.supply_pressure <= rated:
                 raise InvalidScenario(
                     f"supply pressure must be in (0, {rated / 1e3:g}] kPa (cylinder rating), "
-                    f"got {self.supply_pressure / 1e3:g} kPa")
+                    f"got {self.supply_pressure / 1e3:.10g} kPa")
 
     @property
     def preset(self) -> Plant:

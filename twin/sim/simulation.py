@@ -60,7 +60,13 @@ class Trace:
 def scored_angle(trace: Trace, preset: Plant) -> np.ndarray:
     """rad, (T,): the angle the metrics score: on a plant that scores its sensor (``metrics_on_sensor``, as
     the thesis's experiments did) the Hall reading over the spur's pitch radius, else the true output angle."""
-    return trace.measured_position / preset.params.gears.spur_radius if preset.metrics_on_sensor else trace.angle
+    return scored(trace.angle, trace.measured_position, preset)
+
+
+def scored(angle: np.ndarray, measured_position: np.ndarray, preset: Plant) -> np.ndarray:
+    """:func:`scored_angle` from the true output angles (rad) and the Hall readings (m) of the same ticks,
+    for loops that keep no :class:`Trace` (the dm_control environment)."""
+    return measured_position / preset.params.gears.spur_radius if preset.metrics_on_sensor else angle
 
 
 @dataclasses.dataclass(frozen=True)

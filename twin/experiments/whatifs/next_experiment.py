@@ -322,7 +322,7 @@ class NextExperimentWhatIf(Experiment):
         if args.seeds < 2:
             raise InvalidScenario("--seeds: the spread within a member needs at least 2 seeds")
         if not (math.isfinite(args.pressure_step) and 1.0 <= args.pressure_step <= 100.0):
-            raise InvalidScenario(f"--pressure-step: 1-100 kPa, got {args.pressure_step:g}")
+            raise InvalidScenario(f"--pressure-step: 1-100 kPa, got {args.pressure_step:.10g}")
         members = ensemble.members_to_run(args.members)
         rounds = math.ceil(math.log2(len(ladder(args.pressure_step * 1e3)) + 1))  # a map's bisection, at most
         per_seed = len(MAPS) * len(MAP_ANGLES_DEG) * rounds + 1  # the two maps' positions each round, the sine
