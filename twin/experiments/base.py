@@ -133,6 +133,12 @@ def staged(out: pathlib.Path, prefix: str):
         yield stage
         raise_if_stopped()
         refuse_folders_in_the_way(out, stage.names)  # before any file of the set moves
+    except OSError as error:
+        shutil.rmtree(stage.folder, ignore_errors=True)
+        if error.filename is not None:
+            raise
+        # a write's own error (a full disk) names no file: name the folder the set was going into
+        raise OSError(error.errno, error.strerror, str(out)) from None
     except BaseException:
         shutil.rmtree(stage.folder, ignore_errors=True)
         raise

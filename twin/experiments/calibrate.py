@@ -563,13 +563,18 @@ FILE_NAME = "as_built.json"  # what a fit writes in --out (and, installed, the a
 
 def write(data: dict, out: pathlib.Path, name: str = FILE_NAME) -> pathlib.Path:
     """``data`` as ``out/name``, whole or not at all: written beside it, then renamed over it (an
-    earlier file stays as it was if the write fails)."""
+    earlier file stays as it was if the write fails). An OSError names ``out/name``, not its temporary
+    (a full disk's names no file of its own)."""
     path = out / name
     tmp = path.with_name(f".{path.name}.tmp-{os.getpid()}")
     try:
         tmp.write_text(json.dumps(data, indent=1) + "\n")
         raise_if_stopped()
         tmp.replace(path)
+    except OSError as error:
+        if error.filename not in (None, str(tmp)):
+            raise
+        raise OSError(error.errno, error.strerror, str(path)) from None
     finally:
         tmp.unlink(missing_ok=True)
     return path
