@@ -1418,6 +1418,7 @@ def _must_not_run(*args, **kwargs):
     (["calibrate"], "as_built.json", ("twin.experiments.calibrate", "calibrate")),  # a finished fit was lost
     (["sweep", "--seed", "0"], "summary.csv", ("twin.batch.sweep", "run_sweep")),  # found once the grid had run
     (["demo", "--no-plots"], "results.csv", ("twin.experiments.demo", "run_demo")),
+    (["demo"], "smc_T4_seed4.png", ("twin.experiments.demo", "run_demo")),  # a figure it will draw
 ])
 def test_a_folder_in_the_way_of_an_output_is_found_before_the_work(tmp_path, capsys, monkeypatch, command,
                                                                    in_the_way, work):
@@ -1433,29 +1434,67 @@ def test_a_folder_in_the_way_of_an_output_is_found_before_the_work(tmp_path, cap
     assert sorted(p.name for p in out.iterdir()) == [in_the_way]
 
 
-@pytest.mark.parametrize("command, other, summary, first_line", [
-    (["sweep", "--seed", "0"], "demo", "summary.md", "# Thesis controller comparison on the twin ('thesis' plant)\n"),
-    (["demo", "--no-plots"], "sweep", "summary.csv", None),
+def _demos_summary(out):
+    (out / "summary.md").write_text("# Thesis controller comparison on the twin ('thesis' plant, 5 seeds)\n")
+
+
+def _sweeps_summary(out):
+    from twin.batch.tables import write_summary
+
+    write_summary([], out)
+
+
+def _stopped_sweeps_store(out):
+    from twin.batch.sweep import open_store
+
+    open_store(out).close()
+
+
+@pytest.mark.parametrize("command, other, mark, write", [
+    (["sweep", "--seed", "0"], "demo", "summary.md", _demos_summary),
+    (["demo", "--no-plots"], "sweep", "summary.csv", _sweeps_summary),
+    (["demo", "--no-plots"], "sweep", "results.sqlite", _stopped_sweeps_store),  # no summary yet
 ])
 def test_demo_and_sweep_refuse_each_others_folder_which_they_would_half_overwrite(tmp_path, capsys, monkeypatch,
-                                                                                   command, other, summary, first_line):
+                                                                                   command, other, mark, write):
     """Both write results.csv; a sweep into a demo's folder replaced it and left the demo's summary.md
     describing other runs (found by probing, stop 60)."""
-    from twin.batch.tables import SUMMARY_COLUMNS
-
     monkeypatch.setattr(__import__("twin.batch.sweep", fromlist=["run_sweep"]), "run_sweep", _must_not_run)
     monkeypatch.setattr(__import__("twin.experiments.demo", fromlist=["run_demo"]), "run_demo", _must_not_run)
     out = tmp_path / "out"
     out.mkdir()
     (out / "results.csv").write_text("theirs\n")
-    (out / summary).write_text(first_line or ",".join(SUMMARY_COLUMNS) + "\n")
+    write(out)
     assert main([*command, "--out", str(out)]) == 2
-    assert capsys.readouterr().err.strip() == (f"twin: error: --out {out} holds twin {other}'s results ({summary}): "
+    assert capsys.readouterr().err.strip() == (f"twin: error: --out {out} holds twin {other}'s results ({mark}): "
                                                f"give twin {command[0]} a folder of its own")
     assert (out / "results.csv").read_text() == "theirs\n"
-    (out / summary).write_text("# my own notes\n")  # a summary of the user's own is no other command's
-    with pytest.raises(AssertionError, match="before the outputs were checked"):
+
+
+@pytest.mark.parametrize("command", [["sweep", "--seed", "0"], ["demo", "--no-plots"]])
+def test_a_summary_of_the_users_own_is_no_other_commands(tmp_path, monkeypatch, command):
+    monkeypatch.setattr(__import__("twin.batch.sweep", fromlist=["run_sweep"]), "run_sweep", _must_not_run)
+    monkeypatch.setattr(__import__("twin.experiments.demo", fromlist=["run_demo"]), "run_demo", _must_not_run)
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "summary.md").write_text("# my own notes\n")
+    (out / "summary.csv").write_text("controller,rmse\n")
+    with pytest.raises(AssertionError, match="before the outputs were checked"):  # the check let it through
         main([*command, "--out", str(out)])
+
+
+@pytest.mark.parametrize("command, said", [
+    (["run", "--controller", "ffpva", "--trajectory", "1", "--payload", "200.0000001"], "got 200.0000001 g"),
+    (["sweep", "--supply-kpa", "700.0000001", "--out", "never"], "got 700.0000001 kPa"),
+    (["whatif", "next-experiment", "--pressure-step", "100.0000001", "--out", "never"], "got 100.0000001"),
+])
+def test_a_value_just_past_a_bound_is_not_shown_as_the_bound(tmp_path, capsys, monkeypatch, command, said):
+    """They said "got 200 g", "got 700 kPa", "got 100" until stop 60."""
+    monkeypatch.chdir(tmp_path)
+    assert main(command) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.rstrip().endswith(said), err
+    assert list(tmp_path.iterdir()) == []
 
 
 @pytest.mark.parametrize("command", [["sweep", "--seed", "0"], ["whatif", "payload", "--payloads", "0", "--seeds", "1"]])

@@ -78,6 +78,20 @@ def write_summary(summary: Sequence[dict], out: pathlib.Path) -> None:
     write_csv(summary, SUMMARY_COLUMNS, out / "summary.csv")
 
 
+def sweep_mark(out: pathlib.Path) -> str | None:
+    """The file that shows a sweep has written ``out``: its store (``results.sqlite``, from its first finished
+    batch, so a stopped sweep's folder too), or a ``summary.csv`` grouped as a sweep's (by its first columns,
+    so an older sweep's with fewer columns too); None if neither."""
+    if (out / "results.sqlite").exists():
+        return "results.sqlite"
+    first_words = ",".join(GROUP_BY)
+    try:
+        with open(out / "summary.csv", errors="replace") as handle:
+            return "summary.csv" if handle.read(len(first_words)) == first_words else None
+    except OSError:  # none, or unreadable: not taken for a sweep's
+        return None
+
+
 def signed(value: float, width: int = 0) -> str:
     """Signed to 0.01, with a value that rounds to zero shown as +0.00, not -0.00."""
     return f"{round(value, 2) + 0.0:+{width}.2f}"

@@ -16,6 +16,7 @@ from twin.batch.lock import folder_lock
 from twin.batch.stops import raise_if_stopped, swallowed_stops_kept
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
+from twin.experiments.base import named_error
 from twin.physics.model import Orientation
 from twin.plants import PLANTS, Plant
 from twin.plants.as_built import EFFECTS, as_built_plant
@@ -213,21 +214,24 @@ def output_folder(out: pathlib.Path, *, keep_on_failure: bool = False):
         raise
 
 
-def refuse_another_commands_folder(out: pathlib.Path, command: str) -> None:
-    """``twin demo`` and ``twin sweep`` both write ``results.csv``: each refuses a folder that holds the other's
-    results (found by the summary only that one writes, by its first words), which it would overwrite in
-    part, leaving the rest to describe other runs."""
-    from twin.batch.tables import SUMMARY_COLUMNS
-    from twin.experiments.demo import SUMMARY_TITLE
+def check_out_folder(out: pathlib.Path, command: str, names) -> None:
+    """Before ``twin demo``'s or ``twin sweep``'s work: no folder in the way of the files ``names`` it will write
+    in ``out``, and ``out`` not written by the other of the two. Both write ``results.csv``, and each would
+    overwrite the other's in part, leaving the rest to describe other runs; the other is found by
+    :func:`twin.experiments.demo.wrote_folder` and :func:`twin.batch.tables.sweep_mark`."""
+    from twin.batch.tables import sweep_mark
+    from twin.experiments.base import refuse_folders_in_the_way
+    from twin.experiments.demo import wrote_folder
 
-    summaries = {"demo": ("summary.md", SUMMARY_TITLE), "sweep": ("summary.csv", ",".join(SUMMARY_COLUMNS))}
-    for other, (name, first_words) in summaries.items():
-        path = out / name
-        if other != command and path.is_file():
-            with open(path, errors="replace") as handle:
-                if handle.read(len(first_words)) == first_words:
-                    raise InvalidScenario(f"--out {out} holds twin {other}'s results ({name}): give twin {command} "
-                                          "a folder of its own")
+    refuse_folders_in_the_way(out, names)
+    if command == "sweep" and wrote_folder(out):
+        other, shown_by = "demo", "summary.md"
+    elif command == "demo" and (mark := sweep_mark(out)):
+        other, shown_by = "sweep", mark
+    else:
+        return
+    raise InvalidScenario(f"--out {out} holds twin {other}'s results ({shown_by}): give twin {command} a folder "
+                          "of its own")
 
 
 @contextlib.contextmanager
@@ -243,7 +247,9 @@ def all_or_nothing(paths: list[pathlib.Path]):
             os.replace(tmp, path)
     except OSError as error:  # name the file the user asked for, not its temporary
         named = {str(tmp): str(path) for tmp, path in zip(temporary, paths, strict=True)}
-        raise OSError(error.errno, error.strerror, named.get(str(error.filename), error.filename)) from None
+        if str(error.filename) not in named:
+            raise
+        raise named_error(error, named[str(error.filename)]) from None
     finally:
         for tmp in temporary:
             tmp.unlink(missing_ok=True)
@@ -258,7 +264,7 @@ def naming(path: pathlib.Path):
     except OSError as error:
         if error.filename is not None:
             raise
-        raise OSError(error.errno, error.strerror, str(path)) from None
+        raise named_error(error, path) from None
 
 
 def say_written(paths: list[pathlib.Path]) -> None:

@@ -5,16 +5,14 @@ from __future__ import annotations
 import argparse
 import pathlib
 
-from twin.cli.common import output_folder, refuse_another_commands_folder
+from twin.cli.common import check_out_folder, output_folder
 from twin.experiments import arguments
-from twin.experiments.base import refuse_folders_in_the_way
 
 
 def _cmd_demo(args: argparse.Namespace) -> int:
-    from twin.experiments.demo import OUTPUTS, run_demo
+    from twin.experiments.demo import file_names, run_demo
 
-    refuse_folders_in_the_way(args.out, OUTPUTS)  # now, not once the runs are done
-    refuse_another_commands_folder(args.out, "demo")
+    check_out_folder(args.out, "demo", file_names(args.seeds, args.plots))  # now, not once the runs are done
     with output_folder(args.out):  # one writer; a folder made here goes again if the demo is stopped
         return run_demo(out=args.out, seeds=args.seeds, plots=args.plots)
 

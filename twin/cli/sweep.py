@@ -8,10 +8,10 @@ import os
 import pathlib
 import sys
 
-from twin.cli.common import EXIT_INTERRUPTED, output_folder, refuse_another_commands_folder
+from twin.cli.common import EXIT_INTERRUPTED, check_out_folder, output_folder
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
-from twin.experiments.base import refuse_folders_in_the_way, staged, tell_undrawn
+from twin.experiments.base import staged, tell_undrawn
 
 
 def _cmd_sweep(args: argparse.Namespace) -> int:
@@ -37,19 +37,17 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
     address = args.ray_address or os.environ.get("RAY_ADDRESS")
     if args.backend == "ray" and address:
         check_ray_address(address, "--ray-address" if args.ray_address else "RAY_ADDRESS")
-    refuse_folders_in_the_way(args.out, OUTPUTS)  # now, not once the grid has run
-    refuse_another_commands_folder(args.out, "sweep")
+    check_out_folder(args.out, "sweep", OUTPUTS)  # now, not once the grid has run
     # one writer per folder (a second sweep into it is refused, naming this one); SIGTERM stops it as Ctrl-C
-    # does; once its store is open the folder stays whatever stops the sweep: the store keeps the finished
+    # does; the folder stays whatever stops the sweep once its store is open: the store keeps the finished
     # scenarios (a store that cannot be made, on a full disk, leaves no folder made here)
-    with output_folder(args.out) as folder:
-        from twin.batch.sweep import ClusterNotStarted, open_store
+    with output_folder(args.out, keep_on_failure=True) as folder:
+        from twin.batch.store import StoreNotMade
+        from twin.batch.sweep import ClusterNotStarted
 
-        open_store(args.out).close()  # refuses a store of another code version before any output
-        folder.keep = True
         try:
             return _sweep(args, points)
-        except ClusterNotStarted:
+        except (ClusterNotStarted, StoreNotMade):
             folder.keep = False  # no scenario ran: a folder made here goes again, as for any refused input
             raise
 
@@ -81,8 +79,9 @@ def _sweep(args: argparse.Namespace, points: list) -> int:
     from tqdm import tqdm
 
     from twin.batch import tables
-    from twin.batch.sweep import counting, run_sweep
+    from twin.batch.sweep import counting, open_store, run_sweep
 
+    open_store(args.out).close()  # refuses a store of another code version before any output
     print(f"{len(points)} scenario{'' if len(points) == 1 else 's'} -> {args.out.resolve()}", file=sys.stderr)
     bar = tqdm(total=len(points), unit="scenario", file=sys.stderr, dynamic_ncols=True, smoothing=0.1)
     try:

@@ -138,7 +138,7 @@ def staged(out: pathlib.Path, prefix: str):
         if error.filename is not None:
             raise
         # a write's own error (a full disk) names no file: name the folder the set was going into
-        raise OSError(error.errno, error.strerror, str(out)) from None
+        raise named_error(error, out) from None
     except BaseException:
         shutil.rmtree(stage.folder, ignore_errors=True)
         raise
@@ -150,6 +150,12 @@ def staged(out: pathlib.Path, prefix: str):
                 (out / name).unlink(missing_ok=True)
         finally:
             shutil.rmtree(stage.folder, ignore_errors=True)
+
+
+def named_error(error: OSError, filename: pathlib.Path | str) -> OSError:
+    """``error`` naming ``filename`` (for the one-line error): the same errno and words, or ``error`` itself
+    where it has no errno (a library's own message, which a rebuilt OSError would print as "None")."""
+    return error if error.errno is None else OSError(error.errno, error.strerror, str(filename))
 
 
 def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:

@@ -63,6 +63,7 @@ import numpy as np
 
 from twin.batch.stops import raise_if_stopped
 from twin.batch.sweep import code_version, fork_pool, kill_pool
+from twin.experiments.base import named_error
 from twin.experiments.reference import (
     THESIS_EXPERIMENT_RMSE_DEG,
     THESIS_EXPERIMENT_SSE_T1_RANGE_DEG,
@@ -574,7 +575,7 @@ def write(data: dict, out: pathlib.Path, name: str = FILE_NAME) -> pathlib.Path:
     except OSError as error:
         if error.filename not in (None, str(tmp)):
             raise
-        raise OSError(error.errno, error.strerror, str(path)) from None
+        raise named_error(error, path) from None
     finally:
         tmp.unlink(missing_ok=True)
     return path

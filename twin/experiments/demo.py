@@ -106,10 +106,29 @@ SUMMARY_TITLE = "# Thesis controller comparison on the twin"  # summary.md's fir
 OUTPUTS = ("results.csv", "summary.md")  # besides the figures
 
 
+def figure_name(scenario: Scenario) -> str:
+    """A run's PNG (:data:`RUN_FIGURE`)."""
+    return f"{scenario.controller}_T{scenario.trajectory}_seed{scenario.seed}.png"
+
+
+def file_names(seeds: int, plots: bool) -> list[str]:
+    """Every file a demo of ``seeds`` seeds writes in its folder."""
+    return [*OUTPUTS, *(figure_name(s) for s in demo_scenarios(seeds) if plots)]
+
+
+def wrote_folder(out: pathlib.Path) -> bool:
+    """A demo wrote ``out``: its ``summary.md`` begins with :data:`SUMMARY_TITLE` (an unreadable one is not
+    taken for a demo's)."""
+    try:
+        with open(out / "summary.md", errors="replace") as handle:
+            return handle.read(len(SUMMARY_TITLE)) == SUMMARY_TITLE
+    except OSError:
+        return False
+
+
 def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
     out.mkdir(parents=True, exist_ok=True)
-    summary = out / "summary.md"
-    demo_folder = summary.is_file() and summary.read_text(errors="replace").startswith(SUMMARY_TITLE)
+    demo_folder = wrote_folder(out)
     scenarios = demo_scenarios(seeds)
     print(f"Simulating {len(scenarios)} runs on the 'thesis' plant; output in {out.resolve()}", file=sys.stderr)
     with tqdm(total=1, desc="simulating", unit="tick", file=sys.stderr, dynamic_ncols=True) as bar:
@@ -139,9 +158,7 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
             from viz.plots import plot_run
 
             for result in tqdm(results, desc="plotting", unit="png", file=sys.stderr, dynamic_ncols=True):
-                s = result.scenario
-                stage.figure(f"{s.controller}_T{s.trajectory}_seed{s.seed}.png",
-                             lambda path, r=result: plot_run(r, path))
+                stage.figure(figure_name(result.scenario), lambda path, r=result: plot_run(r, path))
     for stale in out.iterdir() if demo_folder else ():  # an earlier demo's figures that this run did not draw
         if RUN_FIGURE.fullmatch(stale.name) and stale.name not in stage.names:
             stale.unlink(missing_ok=True)

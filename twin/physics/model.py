@@ -85,7 +85,7 @@ def build_mjcf(*, params: JointParams = NOMINAL_PARAMS, payload_mass: float = 0.
                orientation: Orientation = Orientation.HORIZONTAL, timestep: float = 1e-3):
     """The joint as a ``dm_control.mjcf`` element tree, ready to compile."""
     if not (0.0 <= payload_mass <= MAX_PAYLOAD) or not math.isfinite(payload_mass):
-        raise InvalidScenario(f"payload must be in [0, {MAX_PAYLOAD * 1e3:g}] g, got {payload_mass * 1e3:g} g")
+        raise InvalidScenario(f"payload must be in [0, {MAX_PAYLOAD * 1e3:g}] g, got {payload_mass * 1e3:.10g} g")
     if not (0 < timestep <= 2e-3):
         raise InvalidScenario(f"timestep must be in (0, 2 ms], got {timestep}")
     with importlib.resources.as_file(MODEL_PATH) as path:

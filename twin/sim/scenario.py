@@ -19,6 +19,18 @@ TRAJECTORY_NUMBERS = (1, 2, 3, 4)
 MAX_SEED = 2**63 - 1  # the largest noise seed a run's results can be stored with (SQLite's INTEGER)
 
 
+def _shown(value, scale: float, unit: str) -> str:
+    """``value`` for an error message, in ``unit`` (``value * scale``, ten digits: a value just past a bound
+    does not read as the bound); text, a truth value or an int past a float's range as given, shortened."""
+    try:
+        if not isinstance(value, bool | np.bool_):
+            return f"{value * scale:.10g} {unit}"
+    except (TypeError, OverflowError):
+        pass
+    given = repr(value)
+    return given if len(given) <= 24 else given[:20] + "..."
+
+
 def _finite(value) -> bool:
     """A finite real number, not a truth value (True == 1) nor text; an int past a float's range is not finite."""
     if isinstance(value, bool | np.bool_) or not isinstance(value, numbers.Real):
@@ -48,34 +60,27 @@ class Scenario:
                 or self.trajectory not in TRAJECTORY_NUMBERS:  # True == 1 and 1.0 == 1: not trajectories
             raise InvalidScenario(f"unknown trajectory {self.trajectory!r}: choose 1, 2, 3 or 4")
         if not _finite(self.payload) or not 0 <= self.payload <= MAX_PAYLOAD:
-            try:
-                shown = repr(self.payload) if isinstance(self.payload, bool) else f"{self.payload * 1e3:.10g} g"
-            except (TypeError, OverflowError):  # text; an int past a float's range
-                shown = repr(self.payload)
-            raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, got {shown}")
+            raise InvalidScenario(f"payload must be between 0 and {MAX_PAYLOAD * 1e3:g} g, "
+                                  f"got {_shown(self.payload, 1e3, 'g')}")
         if not isinstance(self.orientation, Orientation):
             raise InvalidScenario(f"orientation must be an Orientation, got {self.orientation!r}")
         if self.pwm_period is not None:
             base = self.plant if isinstance(self.plant, Plant) else plant(self.plant)
-            if not _finite(self.pwm_period):
-                raise InvalidScenario(f"PWM period must be a number of seconds, got {self.pwm_period!r}")
-            ticks = self.pwm_period / base.timestep
-            if self.pwm_period <= 0 or abs(ticks - round(ticks)) > 1e-9 or not 4 <= round(ticks) <= 100:
+            ticks = self.pwm_period / base.timestep if _finite(self.pwm_period) else math.nan
+            if not ticks > 0 or abs(ticks - round(ticks)) > 1e-9 or not 4 <= round(ticks) <= 100:
                 raise InvalidScenario(f"PWM period must be a whole number of {base.timestep * 1e3:g} ms ticks "
-                                      f"between 4 and 100 ticks, got {self.pwm_period * 1e3:.10g} ms")
+                                      f"between 4 and 100 ticks, got {_shown(self.pwm_period, 1e3, 'ms')}")
         preset = self.preset
         if not isinstance(self.seed, numbers.Integral) or isinstance(self.seed, bool) or not 0 <= self.seed <= MAX_SEED:
             raise InvalidScenario(f"seed must be an integer from 0 to 2^63 - 1, got {self.seed!r}")
         if not isinstance(self.noise, bool | np.bool_):  # "off" is truthy: it would run with the noise on
             raise InvalidScenario(f"noise must be True or False, got {self.noise!r}")
+        object.__setattr__(self, "noise", bool(self.noise))  # NumPy's True is no JSON
         if self.supply_pressure is not None:
             rated = preset.params.cylinder.rated_pressure
-            if not _finite(self.supply_pressure):
-                raise InvalidScenario(f"supply pressure must be a number of Pa, got {self.supply_pressure!r}")
-            if not 0 < self.supply_pressure <= rated:
-                raise InvalidScenario(
-                    f"supply pressure must be in (0, {rated / 1e3:g}] kPa (cylinder rating), "
-                    f"got {self.supply_pressure / 1e3:.10g} kPa")
+            if not _finite(self.supply_pressure) or not 0 < self.supply_pressure <= rated:
+                raise InvalidScenario(f"supply pressure must be in (0, {rated / 1e3:g}] kPa (cylinder rating), "
+                                      f"got {_shown(self.supply_pressure, 1e-3, 'kPa')}")
 
     @property
     def preset(self) -> Plant:
