@@ -1415,17 +1415,16 @@ def _must_not_run(*args, **kwargs):
 
 
 @pytest.mark.parametrize("command, in_the_way, work", [
-    (["calibrate"], "as_built.json", ("twin.experiments.calibrate", "calibrate")),  # a finished fit was lost
-    (["sweep", "--seed", "0"], "summary.csv", ("twin.batch.sweep", "run_sweep")),  # found once the grid had run
-    (["demo", "--no-plots"], "results.csv", ("twin.experiments.demo", "run_demo")),
-    (["demo"], "smc_T4_seed4.png", ("twin.experiments.demo", "run_demo")),  # a figure it will draw
+    (["calibrate"], "as_built.json", "twin.experiments.calibrate.calibrate"),  # a finished fit was lost
+    (["sweep", "--seed", "0"], "summary.csv", "twin.batch.sweep.run_sweep"),  # found once the grid had run
+    (["demo", "--no-plots"], "results.csv", "twin.experiments.demo.run_demo"),
+    (["demo"], "smc_T4_seed4.png", "twin.experiments.demo.run_demo"),  # a figure it will draw
 ])
 def test_a_folder_in_the_way_of_an_output_is_found_before_the_work(tmp_path, capsys, monkeypatch, command,
                                                                    in_the_way, work):
     """Until stop 60 these three found it only when the results went into place: a calibration's whole fit
     (5-12 min) was lost, a sweep's grid ran first."""
-    module, name = work
-    monkeypatch.setattr(__import__(module, fromlist=[name]), name, _must_not_run)
+    monkeypatch.setattr(work, _must_not_run)
     out = tmp_path / "out"
     (out / in_the_way).mkdir(parents=True)
     assert main([*command, "--out", str(out)]) == 2
@@ -1459,8 +1458,8 @@ def test_demo_and_sweep_refuse_each_others_folder_which_they_would_half_overwrit
                                                                                    command, other, mark, write):
     """Both write results.csv; a sweep into a demo's folder replaced it and left the demo's summary.md
     describing other runs (found by probing, stop 60)."""
-    monkeypatch.setattr(__import__("twin.batch.sweep", fromlist=["run_sweep"]), "run_sweep", _must_not_run)
-    monkeypatch.setattr(__import__("twin.experiments.demo", fromlist=["run_demo"]), "run_demo", _must_not_run)
+    monkeypatch.setattr("twin.batch.sweep.run_sweep", _must_not_run)
+    monkeypatch.setattr("twin.experiments.demo.run_demo", _must_not_run)
     out = tmp_path / "out"
     out.mkdir()
     (out / "results.csv").write_text("theirs\n")
@@ -1473,8 +1472,8 @@ def test_demo_and_sweep_refuse_each_others_folder_which_they_would_half_overwrit
 
 @pytest.mark.parametrize("command", [["sweep", "--seed", "0"], ["demo", "--no-plots"]])
 def test_a_summary_of_the_users_own_is_no_other_commands(tmp_path, monkeypatch, command):
-    monkeypatch.setattr(__import__("twin.batch.sweep", fromlist=["run_sweep"]), "run_sweep", _must_not_run)
-    monkeypatch.setattr(__import__("twin.experiments.demo", fromlist=["run_demo"]), "run_demo", _must_not_run)
+    monkeypatch.setattr("twin.batch.sweep.run_sweep", _must_not_run)
+    monkeypatch.setattr("twin.experiments.demo.run_demo", _must_not_run)
     out = tmp_path / "out"
     out.mkdir()
     (out / "summary.md").write_text("# my own notes\n")

@@ -13,6 +13,8 @@ from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
 from twin.experiments.base import refuse_folders_in_the_way, staged, tell_undrawn
 
+FIGURE = "calibration.png"
+
 
 def _cmd_calibrate(args: argparse.Namespace) -> int:
     """Exit 0; 1 when the fit's figure could not be drawn (its file is written, and installed if asked)."""
@@ -28,7 +30,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
         shown = ", ".join(f"{k} {v:.4g}" for k, v in values.items())
         print(f"[{done}/{total}] {stage:7} cost {cost:.4f}  {shown}", file=sys.stderr, flush=True)
 
-    refuse_folders_in_the_way(args.out, [calibrate.FILE_NAME, "calibration.png"])  # now, not after the fit
+    refuse_folders_in_the_way(args.out, [calibrate.FILE_NAME, FIGURE])  # now, not after the fit
     with output_folder(args.out) as folder:
         print(f"calibrate: {counted(calibrate.planned_evaluations(), 'evaluation')} at most, on "
               f"{counted(args.workers, 'worker')}; a line for each once the workers have started",
@@ -43,7 +45,7 @@ def _cmd_calibrate(args: argparse.Namespace) -> int:
             calibrate.write(data, preset.parent, name=preset.name)  # whole or not at all (a rename)
             print(f"installed as the as-built preset: {preset}")
         with staged(args.out, "calibrate") as stage:  # drawn beside the folder's files, then renamed in
-            stage.figure("calibration.png", lambda png: plot_calibration(data, png))
+            stage.figure(FIGURE, lambda png: plot_calibration(data, png))
     for name in stage.names:
         print(f"wrote {args.out / name}")
     tell_undrawn(stage.undrawn)

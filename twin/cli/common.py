@@ -238,7 +238,7 @@ def check_out_folder(out: pathlib.Path, command: str, names) -> None:
 def all_or_nothing(paths: list[pathlib.Path]):
     """Temporary files beside ``paths`` (same folder, same suffix) to write into; each becomes its path
     only once every one was written, and none is left behind if any write fails. An OSError that names a
-    temporary names its path instead (write each inside :func:`naming` so that a full disk's names one)."""
+    temporary names its path instead (write each inside :func:`twin.experiments.base.naming` so that a full disk's names one)."""
     temporary = [path.with_name(f".{path.stem}.tmp-{os.getpid()}{path.suffix}") for path in paths]
     try:
         yield temporary
@@ -253,18 +253,6 @@ def all_or_nothing(paths: list[pathlib.Path]):
     finally:
         for tmp in temporary:
             tmp.unlink(missing_ok=True)
-
-
-@contextlib.contextmanager
-def naming(path: pathlib.Path):
-    """An OSError of the block that names no file (a write's own: a full disk) names ``path``, so that its
-    one-line error says which output could not be written."""
-    try:
-        yield
-    except OSError as error:
-        if error.filename is not None:
-            raise
-        raise named_error(error, path) from None
 
 
 def say_written(paths: list[pathlib.Path]) -> None:

@@ -10,12 +10,12 @@ from twin.cli.common import (
     all_or_nothing,
     compare_of,
     compare_settings,
-    naming,
     say_written,
     scenario_from,
 )
 from twin.exceptions import InvalidScenario
 from twin.experiments import arguments
+from twin.experiments.base import naming
 
 
 def _cmd_run(args: argparse.Namespace) -> int:

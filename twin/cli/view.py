@@ -12,11 +12,11 @@ from twin.cli.common import (
     all_or_nothing,
     compare_of,
     compare_settings,
-    naming,
     scenario_from,
     sigterm_as_interrupt,
 )
 from twin.experiments import arguments
+from twin.experiments.base import naming
 
 
 def _cmd_view(args: argparse.Namespace) -> int:

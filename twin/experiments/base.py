@@ -130,15 +130,10 @@ def staged(out: pathlib.Path, prefix: str):
     disk, not a stop) can. The staging folder goes either way."""
     stage = Staging(pathlib.Path(tempfile.mkdtemp(prefix=f".{prefix}-", dir=out)))
     try:
-        yield stage
-        raise_if_stopped()
-        refuse_folders_in_the_way(out, stage.names)  # before any file of the set moves
-    except OSError as error:
-        shutil.rmtree(stage.folder, ignore_errors=True)
-        if error.filename is not None:
-            raise
-        # a write's own error (a full disk) names no file: name the folder the set was going into
-        raise named_error(error, out) from None
+        with naming(out):  # a write's own error (a full disk) names no file: name the folder the set goes into
+            yield stage
+            raise_if_stopped()
+            refuse_folders_in_the_way(out, stage.names)  # before any file of the set moves
     except BaseException:
         shutil.rmtree(stage.folder, ignore_errors=True)
         raise
@@ -156,6 +151,18 @@ def named_error(error: OSError, filename: pathlib.Path | str) -> OSError:
     """``error`` naming ``filename`` (for the one-line error): the same errno and words, or ``error`` itself
     where it has no errno (a library's own message, which a rebuilt OSError would print as "None")."""
     return error if error.errno is None else OSError(error.errno, error.strerror, str(filename))
+
+
+@contextlib.contextmanager
+def naming(path: pathlib.Path):
+    """An OSError of the block that names no file (a write's own: a full disk) names ``path``, so that its
+    one-line error says which output could not be written."""
+    try:
+        yield
+    except OSError as error:
+        if error.filename is not None:
+            raise
+        raise named_error(error, path) from None
 
 
 def refuse_folders_in_the_way(out: pathlib.Path, names) -> None:
