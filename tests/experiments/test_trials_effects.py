@@ -4,8 +4,8 @@ and trial_payload_cost_effects (what a payload costs), trial_pva_t1 (PVA + DZC o
 one joint), trial_load_friction_edge, trial_t1_start, trial_t2_t3_choices, trial_chapter6_supply,
 trial_actuation_delay, trial_smc_compensation, trial_chamber_buildup (softer or leakier chambers),
 trial_initial_pressure (where the chambers' pressure starts), trial_smc_lead, trial_subtick_coil (pulses that end at
-their exact duty), trial_t4_order (T4's order on each member), trial_vertical_hold (FF + PVA T1 on its side) and
-trial_t1_direction (T1 the other way)."""
+their exact duty), trial_t4_order (T4's order on each member), trial_vertical_hold (FF + PVA T1 on its side),
+trial_t1_direction (T1 the other way) and trial_t1_hold (T1's length)."""
 
 from __future__ import annotations
 
@@ -796,14 +796,20 @@ def test_trial_vertical_hold_prints_what_investigations_md_quotes(capsys):
     assert f"{float(dry_h[5]):.1f}" == f"{float(dry_v[5]):.1f}"  # "in both cases"
 
 
-@pytest.mark.slow  # about 7 s on 2 cores: three laws on T1 both ways, ten seeds
-def test_trial_t1_direction_prints_what_the_docs_quote(capsys):
+def printed_by_t1_trial(name: str, capsys) -> list[str]:
+    """The lines examples/NAME.py prints, run as the T1 trials run: each swaps simulation's trajectory function for
+    its own T1 and must put the committed one back."""
     import twin.sim.simulation as simulation
 
     committed = simulation.trajectory
-    load_trial("trial_t1_direction").main()
+    load_trial(name).main()
     assert simulation.trajectory is committed  # the trial puts T1 back
-    out = capsys.readouterr().out.splitlines()
+    return capsys.readouterr().out.splitlines()
+
+
+@pytest.mark.slow  # about 7 s on 2 cores: three laws on T1 both ways, ten seeds
+def test_trial_t1_direction_prints_what_the_docs_quote(capsys):
+    out = printed_by_t1_trial("trial_t1_direction", capsys)
     assert out[0].startswith("T1 on the twelfth refit's values (6bb9e9258023; the committed preset's), seeds 0-9")
     assert out[1:] == [
         "pva    30 to 150 deg  1.90 ± 0.18, largest 8.5 (9.7), move 3.05 hold 0.90, SSE ±0.43 / ±0.64",
@@ -837,3 +843,32 @@ def test_trial_t1_direction_prints_what_the_docs_quote(capsys):
     assert max(float(line.split()[10].strip("(),")) for line in out[1:3]) < 10  # "stays under 10 deg"
     assert (f"(150 to 30 deg: {pva[1]:.2f} deg mirrored against {pva[0]:.2f} as committed, seeds 0-9, stop 59)"
             in doc_text("as-built.md"))
+
+
+@pytest.mark.slow  # about 20 s on 2 cores: the 13 measured T1 cells with a 4 s hold and as committed, ten seeds
+def test_trial_t1_hold_prints_what_the_docs_quote(capsys):
+    out = printed_by_t1_trial("trial_t1_hold", capsys)
+    assert out[0].startswith("T1 with a 4 s hold on the twelfth refit's values (6bb9e9258023; the committed preset's)")
+    assert out[1].endswith("bit for bit: yes")  # the first 3 s are the committed runs
+    rows = {" ".join(line.split()[:4]): line.split()[4:] for line in out[3:16]}
+    assert len(rows) == 13
+    names = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
+    text = doc_text("investigations.md")
+    quoted = {"pva 0.0 g horizontal": "0 g flat", "ffpva 0.0 g horizontal": "0 g flat",
+              "smc 0.0 g horizontal": "0 g flat", "smc 13.5 g horizontal": "13.5 g flat",
+              "ffpva 13.5 g vertical": "13.5 g on its side"}
+    for key, cell in quoted.items():
+        v = rows[key]  # measured, then value and (xratio) at 1, 1.25, 1.5, 2, 2.5, 3, 4, 5 s
+        shown = [f"{v[i]} {v[i + 1]}" for i in (1, 5, 7, 9, 11, 13, 15)]
+        assert f"| {names[key.split()[0]]}, {cell} | {v[0]} | " + " | ".join(shown) + " |" in text, key
+    within = re.fullmatch(r"within 20 % of 13: (.*)", out[16]).group(1)
+    counts = [int(part.split()[-1]) for part in within.split(", ")]
+    assert counts[1] == 0  # 1.25 s, said beside the table
+    assert "| of the 13 measured T1 cells within 20 % | | " + " | ".join(
+        str(counts[i]) for i in (0, 2, 3, 4, 5, 6, 7)) + " |" in text
+    assert counts[5] == max(counts) == 11  # "the committed 3 s puts the most ... (11)"
+    ratios = [float(part.split()[-1]) for part in out[17].split(": ", 1)[1].split(", ")]
+    assert out[17].startswith("PVA + DZC over FF + PVA, 0 g horizontal (measured 3.00)")
+    assert f"is {min(ratios):.2f}-{max(ratios):.2f} at every" in text
+    assert all(float(r.strip("(x)")) < 0.8 for r in rows["pva 0.0 g horizontal"][2::2])  # within at no length
+    assert f"at most {rows['pva 0.0 g horizontal'][2].strip('()')}, at 1 s" in doc_text("as-built.md")
