@@ -5,7 +5,7 @@ one joint), trial_load_friction_edge, trial_t1_start, trial_t2_t3_choices, trial
 trial_actuation_delay, trial_smc_compensation, trial_chamber_buildup (softer or leakier chambers),
 trial_initial_pressure (where the chambers' pressure starts), trial_smc_lead, trial_subtick_coil (pulses that end at
 their exact duty), trial_t4_order (T4's order on each member), trial_vertical_hold (FF + PVA T1 on its side),
-trial_t1_direction (T1 the other way) and trial_t1_hold (T1's length)."""
+trial_t1_direction (T1 the other way), trial_t1_hold (T1's length) and trial_lag_relation (T1 from T2 and T3)."""
 
 from __future__ import annotations
 
@@ -872,3 +872,41 @@ def test_trial_t1_hold_prints_what_the_docs_quote(capsys):
     assert f"is {min(ratios):.2f}-{max(ratios):.2f} at every" in text
     assert all(float(r.strip("(x)")) < 0.8 for r in rows["pva 0.0 g horizontal"][2::2])  # within at no length
     assert f"at most {rows['pva 0.0 g horizontal'][2].strip('()')}, at 1 s" in doc_text("as-built.md")
+
+
+@pytest.mark.slow  # about 4 s on 2 cores: the three laws on T1-T3, five seeds, and a closed-form delay model
+def test_trial_lag_relation_prints_what_the_docs_quote(capsys):
+    load_trial("trial_lag_relation").main()
+    out = capsys.readouterr().out.splitlines()
+    row = re.compile(r"(rig|twin) +(\w+) +T1 (\S+), largest (\S+) \| from T2 \((\S+)\): +(\S+) ms, T1 (\S+) "
+                     r"\(largest (\S+)\) (x\S+) \| from T3 \((\S+)\): +(\S+) ms, T1 (\S+) \(largest (\S+)\) (x\S+)")
+    rows = {m[1] + " " + m[2]: m.groups()[2:] for m in map(row.fullmatch, out[1:7])}
+    assert len(rows) == 6
+    names = {"pva": "PVA + DZC", "ffpva": "FF + PVA", "smc": "sliding mode"}
+    text = doc_text("investigations.md")
+    for key, (t1, largest, _, d2, p2, l2, x2, _, d3, p3, l3, x3) in rows.items():
+        source, law = key.split()
+        odd = key == "rig pva"
+        x2, x3 = (f"**{x}**" if odd else x for x in (x2, x3))
+        assert (f"| {source}, {names[law]} | {t1} ({largest}) | {d2} ms, {p2} ({l2}) | {x2} | {d3} ms, {p3} ({l3}) "
+                f"| {x3} |") in text, key
+    ratios = {key: [float(v[6][1:]), float(v[11][1:])] for key, v in rows.items()}
+    others = [x for key, pair in ratios.items() if key != "rig pva" for x in pair]
+    assert f"within x{min(others):.2f}-{max(others):.2f}" in text  # five of the six laws
+    assert f"x{min(ratios['rig pva']):.2f}-{max(ratios['rig pva']):.2f} what its own T2 and T3 imply" in text
+    assert min(ratios["rig pva"]) > 1.8 and max(others) < 1.2  # the rig's PVA + DZC alone is about x2
+    implied = sorted((rows["rig pva"][4], rows["rig pva"][9]), key=float)  # the rig's T2 and T3 say T1 ...
+    assert f"{rows['twin pva'][0]} deg against the {implied[0]}-{implied[1]} they imply" in text  # ... the twin runs
+    last = re.fullmatch(r"the delay that gives the rig's PVA \+ DZC T1 \(4.20\): (\S+) ms, which gives T2 (\S+) and "
+                        r"T3 (\S+) \(the rig's 2.93 and 3.00\) and a largest T1 error of (\S+)", out[7])
+    assert f"lag {last[1]} ms, which gives T2 {last[2]} and T3 {last[3]} deg" in text
+    largest = {key: (float(v[1]) / float(v[5]), float(v[1]) / float(v[10])) for key, v in rows.items()}
+    assert f"x{min(largest['rig pva']):.2f}-{max(largest['rig pva']):.2f} the model's" in text
+    rest = [x for key, pair in largest.items() if key != "rig pva" for x in pair]
+    assert f"largest errors are x{min(rest):.2f}-{max(rest):.2f} theirs" in text
+    summary = doc_text("as-built.md")
+    assert "rig's PVA + DZC T1 is x{:.2f}-{:.2f} what its own T2 and T3 imply".format(*sorted(ratios["rig pva"])) in summary
+    assert f"T1 RMSE within x{min(others):.2f}-{max(others):.2f} for five of the six laws" in summary
+    assert f"twin's is what they imply ({rows['twin pva'][0]} against {implied[0]}-{implied[1]})" in summary
+    readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
+    assert f"the rig's own PVA T2 and T3 imply {float(implied[0]):.1f}-{float(implied[1]):.1f} deg, as the twin runs" in readme
