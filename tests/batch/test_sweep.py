@@ -298,9 +298,9 @@ def test_sigkill_midway_then_rerun_gives_every_scenario_once_and_the_same_number
 
     victim = _cli(*args, "--out", "run", cwd=tmp_path, start_new_session=True)
     store = tmp_path / "run" / "results.sqlite"
-    deadline = time.time() + 300
+    deadline = time.monotonic() + 300
     stored = 0
-    while time.time() < deadline and victim.poll() is None:
+    while time.monotonic() < deadline and victim.poll() is None:
         if store.exists():
             try:
                 stored = sqlite3.connect(store).execute("SELECT COUNT(*) FROM results").fetchone()[0]

@@ -1088,7 +1088,9 @@ def test_a_killed_pool_leaves_no_thread_running_into_the_exit():
 
     pool = sweep.fork_pool(2)
     futures = [pool.submit(time.sleep, 30) for _ in range(4)]
+    deadline = time.monotonic() + 60
     while not any(f.running() for f in futures):
+        assert time.monotonic() < deadline, "no worker started within 60 s"
         time.sleep(0.01)
     manager = pool._executor_manager_thread
     assert manager is not None and manager.is_alive()
@@ -1161,6 +1163,7 @@ def test_a_grid_file_over_1_mb_is_refused_without_reading_it_all(tmp_path):
     assert grid.read_toml(small) == {"seed": [0, 1]}
 
 
+@pytest.mark.slow  # 5-8 s on 2 cores: a whole what-if in a subprocess, the cheapest that draws a progress bar
 def test_a_command_started_with_its_error_stream_closed_still_runs(tmp_path):
     """`twin whatif gear-load --out DIR 2>&-` exited 1 with no word and removed its folder: the progress bar
     wrote to a missing stderr (a helper's probe, stop 40). Now both streams fall back to /dev/null."""

@@ -314,16 +314,18 @@ def test_valid_defaults_construct():
 
 
 def test_feedforward_accounts_for_the_desired_acceleration():
-    """R4 = [P A - s (M a_d + F_l) - R1 A^2 |v_d|] / (A^2 |v_d|), d = (R4 / c)^(1 / -2.1706) (eq. 5.3.2-5.3.3)."""
+    """d from the feed-forward at v_d and a_d, put into eq. 4.3.6 with every term written out, M a = P_ws A - F_c(y)
+    - F_v v - (R1 + R(d)) A^2 v, gives the acceleration back, either way (the round trip above, accelerating)."""
     model = NominalModel.thesis()
-    A, y, v, a = model.bore_area, 8e-3, 10e-3, 2.0
-    loss = float(coulomb_force(model.friction, np.array([y]), np.array([1.0]))[0]) + model.friction.viscous * v
+    y, v, a = 8e-3, 10e-3, 2.0
+    p_ws, f_v = 300e3, 45.9
+    r1 = 1.8372e14 * 100.0**-2.1706
     for sign in (1.0, -1.0):
-        r4 = (model.supply_pressure * A - sign * (model.mass * sign * a + sign * loss)
-              - model.valves.open_resistance * A**2 * v) / (A**2 * v)
-        expected = sign * (r4 / 1.8372e14) ** (1 / -2.1706)
-        got = feedforward_duty(model, np.array([y]), np.array([sign * v]), np.array([sign * a]))[0]
-        assert got == pytest.approx(expected, rel=1e-12)
+        d = feedforward_duty(model, np.array([y]), np.array([sign * v]), np.array([sign * a]))[0]
+        assert 0.0 < sign * d < 100.0
+        r_d = 1.8372e14 * abs(d) ** -2.1706
+        force = p_ws * AREA - f_c_by_hand(y) - f_v * v - (r1 + r_d) * AREA**2 * v  # N, along the motion
+        assert force / model.mass == pytest.approx(a, rel=1e-9)
     accelerating = feedforward_duty(model, np.array([y]), np.array([v]), np.array([a]))[0]
     cruising = feedforward_duty(model, np.array([y]), np.array([v]), np.array([0.0]))[0]
     assert accelerating > cruising  # more force needed: less resistance, more duty

@@ -221,11 +221,12 @@ def test_substeps_period_error_at_4_9_ms(substeps):
 def test_default_substep_period_error_at_the_joints_own_mass():
     """At the joint's own mass the resonance is 973 Hz (1.03 ms): a 0.1 ms sub-step (here h = 0.1 ms
     with one sub-step; the old default of 10 per tick) has omega delta = 0.61, so implicit Euler rings
-    11-12 % slow (measured +11.6 %) and damps it out within a few periods; the default 10 us sub-step
-    (here 10 per 0.1 ms) resolves it (+0.12 %)."""
+    11-12 % slow (the closed form above: +11.4 %; measured +11.6 %) and damps it out within a few periods; the
+    default 10 us sub-step (here 10 per 0.1 ms) resolves it (+0.12 %)."""
     period, closed = ringing_period(mass=MASS, substeps=1, h=1e-4, duration=0.03)
     assert closed == pytest.approx(1.028e-3, rel=0.01)
-    assert 0.10 < period / closed - 1.0 < 0.13
+    omega_delta = 2.0 * math.pi / closed * 1e-4
+    assert period / closed - 1.0 == pytest.approx(omega_delta / math.atan(omega_delta) - 1.0, abs=0.005)
     fine, _ = ringing_period(mass=MASS, substeps=10, h=1e-4, duration=0.03)
     assert fine == pytest.approx(closed, rel=0.005)  # 0.01 ms sub-steps: measured +0.12 %
 

@@ -159,7 +159,7 @@ class JointTask(base.Task):
     """``track`` or ``hold``; see the module docstring."""
 
     def __init__(self, *, name: str, trajectory_number: int | None, scenario: Scenario,
-                 randomise_load: bool, seed: int | None):
+                 randomise_load: bool, seed: int):
         super().__init__(random=seed)
         self.name = name
         self.trajectory_number = trajectory_number

@@ -6,8 +6,11 @@ period-averaged flow, once the valve's cycle has settled, against the pressure d
 of its slope is the twin's R(d), set beside eq. 4.4.2 at duties 30-100 % in 5 % steps. The valve
 held open is R(100 %) by construction (its open conductance); every other duty is an outcome of
 the coil, the plunger and the rig's water column. The twin's flow is proportional to the pressure
-drop, so its lines pass through zero; the thesis's did not (it could not measure flows below
-1e-6 m^3/s), and the answer says which of the twin's points it could not have measured.
+drop by the model's construction, not as a finding: the valve is a linear resistance scaled by its
+opening, the column's inertance is linear too, and no pressure force acts on the plunger, so the flow
+fraction a duty gives (simulated once per duty) holds at every drop. So its lines pass through zero;
+the thesis's did not (it could not measure flows below 1e-6 m^3/s), and the answer says which of the
+twin's points it could not have measured.
 """
 
 from __future__ import annotations
@@ -70,12 +73,11 @@ def emergent_dead_zone(params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTest
 
 def valve_study(params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigParams = NOMINAL_RIG) -> Outcome:
     valves = NOMINAL_PARAMS.valves
-    rows, unmeasurable, intercepts = [], [], []
+    rows, unmeasurable = [], []
     for duty in DUTIES:
-        resistance, intercept, flows = replica(duty, params=params, rig=rig)
+        resistance, _, flows = replica(duty, params=params, rig=rig)
         rows.append({"duty_pct": duty, "resistance_eq442_pa_s_per_m3": float(valves.resistance(duty)),
                      "resistance_twin_pa_s_per_m3": resistance})
-        intercepts.append(abs(intercept))
         unmeasurable += [(duty, drop) for drop, flow in zip(rig.pressure_drops, flows, strict=True)
                          if 0 < flow < rig.min_measurable_flow]
     checked = [r for r in rows if r["duty_pct"] >= CHECKED_FROM]
@@ -95,8 +97,9 @@ def valve_study(params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigPara
               + "R(100 %) is the open valve's resistance by construction. "
               f"Full pulse: opens {opening * 1e3:.1f} ms after the coil switches on, shuts {closing * 1e3:.1f} ms after "
               f"it switches off (thesis: 5 and 2 ms). Dead zone: no flow below {emergent_dead_zone(params, rig):g} % "
-              f"(thesis: about 30 %). Flow is proportional to the pressure drop (largest intercept "
-              f"{max(intercepts):.1e} m^3/s); {len(unmeasurable)} of the replica's points are below the "
+              f"(thesis: about 30 %). Flow is proportional to the pressure drop by the valve model's construction (a "
+              "linear resistance scaled by the opening, no pressure force on the plunger), so the lines pass through "
+              f"zero; {len(unmeasurable)} of the replica's points are below the "
               f"{rig.min_measurable_flow:.0e} m^3/s the thesis could measure"
               + (f" (duty {', '.join(sorted({f'{d:g} %' for d, _ in unmeasurable}))} at the lowest drops)."
                  if unmeasurable else "."))
