@@ -6,7 +6,7 @@ is the odd one, from the rig's numbers alone, with the simplest model of trackin
 
 The model: a joint that follows its reference a fixed time tau behind, e(t) = theta_d(t) - theta_d(t - tau), at
 rest at the start before it (closed form on the twin's own T1-T3 references, sampled at its 1 ms ticks over their
-committed lengths). A run's RMSE is then a function of tau alone, for each trajectory. For each law the script
+committed lengths: twin.sim.metrics.lagging_metrics, which `twin validate` reads the rig's cells with too). A run's RMSE is then a function of tau alone, for each trajectory. For each law the script
 reads tau from its T2 RMSE and, apart, from its T3 RMSE, and predicts its T1 RMSE and largest T1 error with each
 (beside the measured largest error: the rig's as the thesis gives it, one number per law; the twin's, the mean of its
 runs').
@@ -27,32 +27,31 @@ import argparse
 import math
 
 import numpy as np
-from scipy.optimize import brentq
 
 from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_EXPERIMENT_MAX_ERROR_DEG, THESIS_EXPERIMENT_RMSE_DEG
 from twin.physics.trajectories import trajectory
 from twin.plants import plant
+from twin.sim.metrics import delay_for_rmse, lagging_metrics
 from twin.sim.scenario import Scenario
 
 SEEDS = range(5)  # the verdicts' seeds
 LAWS = ("pva", "ffpva", "smc")
 PLANT = plant("as-built")
-LONGEST_DELAY = 0.3  # s, the search's top: far past any law's (the rig's PVA + DZC T1 alone would need 50 ms)
 
 
 def lagging_rmse(number: int, delay: float) -> tuple[float, float]:
     """deg: the RMSE and the largest |error| of a joint that follows trajectory ``number`` ``delay`` s behind."""
     r = PLANT.params.gears.spur_radius
-    path = trajectory(number, spur_radius=r)
-    t = np.arange(int(round(path.duration / PLANT.timestep))) * PLANT.timestep
-    error = (path.sample(t, r).position - path.sample(t - delay, r).position) / r
-    return math.degrees(math.sqrt(np.mean(error**2))), math.degrees(np.max(np.abs(error)))
+    m = lagging_metrics(trajectory(number, spur_radius=r), delay, spur_radius=r, timestep=PLANT.timestep)
+    return math.degrees(m.rmse), math.degrees(m.max_error)
 
 
 def delay_for(number: int, rmse_deg: float) -> float:
     """s, the delay at which a lagging joint's RMSE on trajectory ``number`` is ``rmse_deg``."""
-    return brentq(lambda d: lagging_rmse(number, d)[0] - rmse_deg, 1e-6, LONGEST_DELAY, xtol=1e-9)
+    r = PLANT.params.gears.spur_radius
+    return delay_for_rmse(trajectory(number, spur_radius=r), math.radians(rmse_deg), spur_radius=r,
+                          timestep=PLANT.timestep)
 
 
 def twin_means() -> tuple[dict[str, dict[int, float]], dict[str, float]]:
@@ -81,7 +80,7 @@ def main() -> None:
                 row.append(f"from T{number} ({means[law][number]:.2f}): {delay * 1e3:4.1f} ms, T1 {predicted:.2f} "
                            f"(largest {predicted_largest:.1f}) x{t1 / predicted:.2f}")
             print(f"{source:4s} {law:5s} T1 {t1:.2f}, largest {largest:.1f} | " + " | ".join(row))
-    delay = brentq(lambda d: lagging_rmse(1, d)[0] - rig["pva"][1], 1e-6, LONGEST_DELAY, xtol=1e-9)
+    delay = delay_for(1, rig["pva"][1])
     print(f"the delay that gives the rig's PVA + DZC T1 ({rig['pva'][1]:.2f}): {delay * 1e3:.1f} ms, which gives T2 "
           f"{lagging_rmse(2, delay)[0]:.2f} and T3 {lagging_rmse(3, delay)[0]:.2f} (the rig's "
           f"{rig['pva'][2]:.2f} and {rig['pva'][3]:.2f}) and a largest T1 error of {lagging_rmse(1, delay)[1]:.1f}")

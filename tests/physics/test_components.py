@@ -16,7 +16,7 @@ from twin.physics.friction import coulomb_force
 from twin.physics.params import FrictionParams, GearParams, ObserverParams
 from twin.physics.sensing import FirstOrderObserver
 from twin.physics.trajectories import trajectory
-from twin.sim.metrics import tracking_metrics
+from twin.sim.metrics import LONGEST_LAG, delay_for_rmse, lagging_metrics, tracking_metrics
 
 DT = 1e-3  # s, sensor sample period (§5)
 R_SPUR = 9.525e-3 / 2  # m, spur pitch radius (§2)
@@ -100,6 +100,33 @@ def test_metrics_by_hand():
     assert m.rmse == pytest.approx(math.sqrt(26.0 / 4.0), rel=1e-12)
     assert m.sse == pytest.approx(-1.0)
     assert m.max_error == pytest.approx(4.0)
+
+
+
+@pytest.mark.parametrize("delay", [0.0123, 0.0245, 0.05])
+def test_a_joint_lagging_t2s_ramp_by_a_fixed_time_errs_by_the_closed_form(delay):
+    """On T2's ramp (omega = 10 mm/s / r_s from rest) a joint that follows tau behind errs by omega t until tau,
+    then by omega tau: at ticks t_k = k h, RMSE^2 = omega^2 (h^2 sum_{k<K} k^2 + (N - K) tau^2) / N with K the
+    ticks before tau, and sum_{k<K} k^2 = (K - 1) K (2K - 1) / 6; the largest error omega tau."""
+    r, h = 4.7625e-3, 1e-3
+    omega = 10e-3 / r
+    n = 1000  # T2's 1 s
+    k = math.ceil(delay / h)  # ticks k h < tau
+    squares = (k - 1) * k * (2 * k - 1) / 6
+    closed = omega * math.sqrt((h * h * squares + (n - k) * delay * delay) / n)
+    m = lagging_metrics(trajectory(2, spur_radius=r), delay, spur_radius=r, timestep=h)
+    assert m.rmse == pytest.approx(closed, rel=1e-9)
+    assert m.max_error == pytest.approx(omega * delay, rel=1e-9)
+    assert math.isnan(m.sse)  # T2 ends moving
+
+
+def test_the_delay_for_an_rmse_is_the_one_that_gives_it_and_nan_past_the_search():
+    r, h = 4.7625e-3, 1e-3
+    t3 = trajectory(3, spur_radius=r)
+    rmse = lagging_metrics(t3, 0.0187, spur_radius=r, timestep=h).rmse
+    assert delay_for_rmse(t3, rmse, spur_radius=r, timestep=h) == pytest.approx(0.0187, abs=1e-8)
+    too_much = lagging_metrics(t3, LONGEST_LAG, spur_radius=r, timestep=h).rmse * 1.01
+    assert math.isnan(delay_for_rmse(t3, too_much, spur_radius=r, timestep=h))
 
 
 # --------------------------------------------------------------------------- trajectories (§7)

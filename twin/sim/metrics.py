@@ -7,6 +7,10 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
+from scipy.optimize import brentq
+
+from twin.physics.ticks import whole_ticks
+from twin.physics.trajectories import Trajectory
 
 
 @dataclasses.dataclass(frozen=True)
@@ -25,6 +29,31 @@ def tracking_metrics(desired: np.ndarray, actual: np.ndarray, *, ends_at_rest: b
     return Metrics(rmse=float(np.sqrt(np.mean(error**2))), sse=float(error[-1]) if ends_at_rest else math.nan,
                    max_error=float(np.max(np.abs(error))),
                    rest_errors=tuple(float(error[min(k, len(error) - 1)]) for k in rest_end_ticks))
+
+
+LONGEST_LAG = 0.3  # s, the top of delay_for_rmse's search: past any law's on this joint (the rig's laws lag 13-25 ms)
+
+
+def lagging_metrics(path: Trajectory, delay: float, *, spur_radius: float, timestep: float) -> Metrics:
+    """The metrics of a joint that follows ``path`` a fixed ``delay`` (s) behind, at rest at its start before it:
+    e(t) = theta_d(t) - theta_d(t - delay), at the run's ticks (``timestep`` apart, as :func:`tracking_metrics`
+    reads a run). A ruler for reading measured RMSEs against each other, not a plant: it knows no valve or
+    friction."""
+    t = np.arange(whole_ticks(path.duration, timestep, what="trajectory")) * timestep
+    desired = path.sample(t, spur_radius).position / spur_radius
+    lagging = path.sample(t - delay, spur_radius).position / spur_radius
+    return tracking_metrics(desired, lagging, ends_at_rest=path.ends_at_rest)
+
+
+def delay_for_rmse(path: Trajectory, rmse: float, *, spur_radius: float, timestep: float) -> float:
+    """s, the delay at which :func:`lagging_metrics` on ``path`` has RMSE ``rmse`` (rad); nan when no delay up to
+    :data:`LONGEST_LAG` gives it."""
+    def gap(delay: float) -> float:
+        return lagging_metrics(path, delay, spur_radius=spur_radius, timestep=timestep).rmse - rmse
+    low, high = 1e-6, LONGEST_LAG
+    if not gap(low) <= 0.0 <= gap(high):
+        return math.nan
+    return brentq(gap, low, high, xtol=1e-9)
 
 
 @dataclasses.dataclass(frozen=True)
