@@ -898,15 +898,29 @@ def test_trial_lag_relation_prints_what_the_docs_quote(capsys):
     implied = sorted((rows["rig pva"][4], rows["rig pva"][9]), key=float)  # the rig's T2 and T3 say T1 ...
     assert f"{rows['twin pva'][0]} deg against the {implied[0]}-{implied[1]} they imply" in text  # ... the twin runs
     last = re.fullmatch(r"the delay that gives the rig's PVA \+ DZC T1 \(4.20\): (\S+) ms, which gives T2 (\S+) and "
-                        r"T3 (\S+) \(the rig's 2.93 and 3.00\) and a largest T1 error of (\S+)", out[7])
+                        r"T3 (\S+) \(the rig's 2.93 and 3.00\) and a largest T1 error of (\S+)", out[12])
     assert f"lag {last[1]} ms, which gives T2 {last[2]} and T3 {last[3]} deg" in text
     largest = {key: (float(v[1]) / float(v[5]), float(v[1]) / float(v[10])) for key, v in rows.items()}
-    assert f"x{min(largest['rig pva']):.2f}-{max(largest['rig pva']):.2f} the model's" in text
+    assert f"x{min(largest['rig pva']):.2f}-{max(largest['rig pva']):.2f} the ruler's" in text
     rest = [x for key, pair in largest.items() if key != "rig pva" for x in pair]
     assert f"largest errors are x{min(rest):.2f}-{max(rest):.2f} theirs" in text
     summary = doc_text("as-built.md")
     assert "rig's PVA + DZC T1 is x{:.2f}-{:.2f} what its own T2 and T3 imply".format(*sorted(ratios["rig pva"])) in summary
-    assert f"T1 RMSE within x{min(others):.2f}-{max(others):.2f} for five of the six laws" in summary
+    assert f"T1 RMSE within x{min(others):.2f}-{max(others):.2f} for five of six (source, law) pairs" in summary
     assert f"twin's is what they imply ({rows['twin pva'][0]} against {implied[0]}-{implied[1]})" in summary
     readme = " ".join((ROOT / "README.md").read_text(encoding="utf-8").split())
-    assert f"the rig's own PVA T2 and T3 imply {float(implied[0]):.1f}-{float(implied[1]):.1f} deg, as the twin runs" in readme
+    assert (f"by a fixed-lag ruler the rig's own PVA T2 and T3 imply {float(implied[0]):.1f}-{float(implied[1]):.1f} deg, "
+            "as the twin runs") in readme
+    at = {}  # the rig's ratios over other T1 lengths: PVA + DZC's range, the others', PVA + DZC's over theirs
+    for line in out[8:12]:
+        m = re.fullmatch(r"  (\S+) s: PVA \+ DZC (x\S+), FF \+ PVA and sliding mode (x\S+); PVA \+ DZC's over theirs "
+                         r"(x\S+)", line)
+        at[m[1]] = m.groups()[1:]
+    assert at["3"][:2] == (f"x{min(ratios['rig pva']):.2f}-{max(ratios['rig pva']):.2f}",
+                           "x{:.2f}-{:.2f}".format(*(f(ratios[k][i] for k in ("rig ffpva", "rig smc") for i in (0, 1))
+                                                    for f in (min, max))))
+    assert len({v[2] for v in at.values()}) == 1  # the comparison does not turn on the length
+    assert (f"DZC is {at['1.5'][0]}, {at['2'][0]} and {at['5'][0]} of what its T2 and T3 imply, and its FF + "
+            f"PVA and sliding mode {at['1.5'][1]}, {at['2'][1]} and {at['5'][1]}") in text
+    assert f"the rig's PVA + DZC is {at['3'][2]} of its other two laws" in text
+    assert f"the rig's PVA + DZC is {at['3'][2]} of its other two laws by this ruler" in summary

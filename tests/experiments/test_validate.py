@@ -830,6 +830,23 @@ def _miss_report() -> tuple[validate.Validation, list[dict], str]:
     return v, validate.misses(v), validate.report(v)
 
 
+def test_a_measured_t1_departs_from_its_own_t2_and_t3_only_off_both_with_the_twin_within_both():
+    # off both (x2.02, x2.19 of 2.08, 1.92) with the twin within both (x0.90, x0.97): departs
+    assert readings.departs(4.2, [2.08, 1.92], 1.87)
+    assert not readings.departs(2.4, [2.08, 1.92], 1.87)  # off 1.92 (x1.25) but not 2.08 (x1.15)
+    assert not readings.departs(4.2, [2.08, 1.50], 1.87)  # the twin within 2.08 (x0.90) but not 1.50 (x1.25)
+    assert not readings.departs(4.2, [2.08, math.nan], 1.87) and not readings.departs(4.2, [], 1.87)
+
+
+def test_only_a_flat_t1_cell_of_a_law_measured_on_t2_and_t3_is_read_by_them():
+    flat_t1 = {"controller": "pva", "trajectory": 1, "payload_g": 0.0, "orientation": "horizontal", "measured": 4.2}
+    assert readings.own_trajectories(flat_t1, 1.87) == readings.implied_t1("pva")
+    assert readings.own_trajectories(dict(flat_t1, trajectory=2, measured=4.2), 1.87) is None  # T2 reads no T1
+    assert readings.own_trajectories(dict(flat_t1, payload_g=6.5), 1.87) is None  # a loaded cell
+    assert readings.own_trajectories(dict(flat_t1, orientation="vertical"), 1.87) is None  # on its side
+    assert readings.implied_t1("unknown") is None  # a law the thesis did not measure on T2 and T3
+
+
 def test_misses_read_each_miss_by_the_first_rule_that_applies(monkeypatch):
     v, missed, text = _miss_report()
     read = {(m["comparison"], m["controller"], m["trajectory"], m["payload_g"], m["orientation"]): m for m in missed}
@@ -845,12 +862,13 @@ def test_misses_read_each_miss_by_the_first_rule_that_applies(monkeypatch):
     (d2, t2), (d3, t3) = readings.implied_t1("pva")
     assert (round(d2 * 1e3, 1), round(t2, 2), round(d3 * 1e3, 1), round(t3, 2)) == (24.6, 2.08, 22.6, 1.92)
     assert pva1["what_the_twin_shows"] == (
-        "a joint that lags its reference a fixed time, read from the rig's own T2 and T3 of this law (22.6-24.6 ms; "
-        "closed form on the twin's references), gives T1 1.92-2.08 deg: the rig measured 4.20 (x2.02-x2.19 of that), "
-        "the twin 1.68. The rig's other laws' T1 are x0.95-x1.10 of what their own T2 and T3 imply, so it is the "
-        "rig's cell that departs: its runs met something on T1 that this law's T2 and T3 and the other laws' T1 did "
-        "not; what, the thesis does not say. The rig's runs also scattered more (std 0.76 against the twin's 0.00). "
-        "Its largest error was 13.5 deg, the twin's 7.7 (mean over its runs; 8.5 at most)")
+        "a joint that lags its reference a fixed time (a ruler, not a plant), read from the rig's own T2 and T3 of "
+        "this law (22.6-24.6 ms; exact on the twin's references at their ticks, over the twin's run lengths), gives "
+        "T1 1.92-2.08 deg: the rig measured 4.20 (x2.02-x2.19 of that), the twin 1.68. The rig's other laws' T1 are "
+        "x0.95-x1.10 of what their own T2 and T3 imply. So by this ruler the rig's cell is the one that does not "
+        "follow from its law's T2 and T3; whether something disturbed those runs or this law meets something on T1 "
+        "that the twin lacks, the thesis's data do not tell apart. The rig's runs also scattered more (std 0.76 "
+        "against the twin's 0.00). Its largest error was 13.5 deg, the twin's 7.7 (mean over its runs; 8.5 at most)")
     with monkeypatch.context() as patched:  # the next rule, as before 2026-12-08
         patched.setattr(readings, "implied_t1", lambda controller: None)
         assert validate.misses(v)[0]["what_the_twin_shows"] == (  # PVA T2 is out: no "within on"; std 0

@@ -7,7 +7,6 @@ import math
 from collections.abc import Sequence
 
 import numpy as np
-from scipy.optimize import brentq
 
 from twin.physics.ticks import whole_ticks
 from twin.physics.trajectories import Trajectory
@@ -48,6 +47,8 @@ def lagging_metrics(path: Trajectory, delay: float, *, spur_radius: float, times
 def delay_for_rmse(path: Trajectory, rmse: float, *, spur_radius: float, timestep: float) -> float:
     """s, the delay at which :func:`lagging_metrics` on ``path`` has RMSE ``rmse`` (rad); nan when no delay up to
     :data:`LONGEST_LAG` gives it."""
+    from scipy.optimize import brentq  # here, not at the top: every run imports this module, few read a lag
+
     def gap(delay: float) -> float:
         return lagging_metrics(path, delay, spur_radius=spur_radius, timestep=timestep).rmse - rmse
     low, high = 1e-6, LONGEST_LAG

@@ -46,18 +46,18 @@ def line_fit(x, y) -> tuple[Fraction, Fraction]:
 
 
 def replica(duty: float, *, params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigParams = NOMINAL_RIG
-            ) -> tuple[float, float, np.ndarray]:
-    """(R in Pa s/m^3 from the slope, intercept in m^3/s, the mean flows (m^3/s) at each of the
-    rig's pressure drops) at PWM ``duty`` %."""
+            ) -> tuple[float, np.ndarray]:
+    """(R in Pa s/m^3 from the slope, the mean flows (m^3/s) at each of the rig's pressure drops) at PWM
+    ``duty`` %. The line's intercept is zero by construction (see the module docstring), so it is not kept."""
     valves = NOMINAL_PARAMS.valves
     fraction = solenoid.mean_flow_fraction(params, duty, period=valves.pwm_period, h=params.step,
                                            inertance_time=rig.inertance_time)
     drops = np.array(rig.pressure_drops)
-    flows = fraction * drops / valves.open_resistance  # a linear valve: each drop simulated gives the same fraction
+    flows = fraction * drops / valves.open_resistance  # a linear valve: one fraction holds at every drop
     if fraction <= 0.0:
-        return math.inf, 0.0, flows
-    slope, intercept = line_fit(drops, flows)
-    return float(1 / slope), float(intercept), flows
+        return math.inf, flows
+    slope, _ = line_fit(drops, flows)
+    return float(1 / slope), flows
 
 
 def emergent_dead_zone(params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigParams = NOMINAL_RIG
@@ -75,7 +75,7 @@ def valve_study(params: SolenoidParams = NOMINAL_SOLENOID, rig: ValveTestRigPara
     valves = NOMINAL_PARAMS.valves
     rows, unmeasurable = [], []
     for duty in DUTIES:
-        resistance, _, flows = replica(duty, params=params, rig=rig)
+        resistance, flows = replica(duty, params=params, rig=rig)
         rows.append({"duty_pct": duty, "resistance_eq442_pa_s_per_m3": float(valves.resistance(duty)),
                      "resistance_twin_pa_s_per_m3": resistance})
         unmeasurable += [(duty, drop) for drop, flow in zip(rig.pressure_drops, flows, strict=True)

@@ -56,11 +56,12 @@ def _unknown_text(detail: dict, t: int) -> str:
 def implied_t1(controller: str) -> tuple[tuple[float, float], ...] | None:
     """What the rig's measured T2 and T3 RMSE of ``controller`` (§8) imply for its T1, by a joint that lags its
     reference a fixed time (:func:`twin.sim.metrics.lagging_metrics` on the twin's references): (delay s, T1 RMSE
-    deg) read from T2, then from T3; None for a law not measured on both."""
-    cells = THESIS_EXPERIMENT_RMSE_DEG[controller]
+    deg) read from T2, then from T3; None for a law not measured on both. The references and the tick are every
+    preset's; the `thesis` preset's are read (it needs no calibration file)."""
+    cells = THESIS_EXPERIMENT_RMSE_DEG.get(controller, {})
     if 2 not in cells or 3 not in cells:
         return None
-    base = plant("as-built")
+    base = plant("thesis")
     r, h = base.params.gears.spur_radius, base.timestep
     read = []
     for number in (2, 3):
@@ -71,27 +72,40 @@ def implied_t1(controller: str) -> tuple[tuple[float, float], ...] | None:
     return tuple(read)
 
 
-def _departs(measured: float, implied: Sequence[float], twin: float, twin_high: bool) -> bool:
-    """Whether a measured T1 is out of tolerance of everything its own T2 and T3 imply, the way the twin misses
-    it, while the twin's is within tolerance of all of it."""
-    return (all(math.isfinite(t1) for t1 in implied)
-            and all(abs(measured / t1 - 1) > RMSE_TOLERANCE and (measured > t1) != twin_high for t1 in implied)
+def departs(measured: float, implied: Sequence[float], twin: float) -> bool:
+    """Whether a measured T1 is out of tolerance of each value its own T2 and T3 imply while the twin's is within
+    tolerance of each. (For a twin that misses the measured value, that puts the measured value on the other side
+    of them from the twin's: within 20 % of t1 and over 20 % above a measured value over 20 % above t1 cannot both
+    hold, nor the same below.)"""
+    return (len(implied) > 0 and all(math.isfinite(t1) for t1 in implied)
+            and all(abs(measured / t1 - 1) > RMSE_TOLERANCE for t1 in implied)
             and all(abs(twin / t1 - 1) <= RMSE_TOLERANCE for t1 in implied))
+
+
+def own_trajectories(r: dict, twin: float) -> tuple[tuple[float, float], ...] | None:
+    """What the rig's own T2 and T3 imply for RMSE row ``r`` (:func:`implied_t1`) when ``r`` is a flat T1 cell
+    that :func:`departs` from them with the twin at ``twin`` deg; else None."""
+    if _loaded(r) or r["trajectory"] != 1:
+        return None
+    own = implied_t1(r["controller"])
+    return own if own and departs(r["measured"], [t1 for _, t1 in own], twin) else None
 
 
 def _own_trajectories_text(r: dict, own: Sequence[tuple[float, float]], twin: float) -> str:
     implied = sorted(t1 for _, t1 in own)
     delays = sorted(delay * 1e3 for delay, _ in own)
     ratios = sorted(r["measured"] / t1 for t1 in implied)
-    others = [THESIS_EXPERIMENT_RMSE_DEG[law][1][0] / t1 for law in THESIS_EXPERIMENT_RMSE_DEG
-              if law != r["controller"] and implied_t1(law) for _, t1 in implied_t1(law)]
-    return (f"a joint that lags its reference a fixed time, read from the rig's own T2 and T3 of this law "
-            f"({delays[0]:.1f}-{delays[1]:.1f} ms; closed form on the twin's references), gives T1 "
-            f"{implied[0]:.2f}-{implied[1]:.2f} deg: the rig measured {r['measured']:.2f} (x{ratios[0]:.2f}-"
-            f"x{ratios[1]:.2f} of that), the twin {twin:.2f}"
+    others = [THESIS_EXPERIMENT_RMSE_DEG[law][1][0] / t1 for law, read in
+              ((law, implied_t1(law)) for law in THESIS_EXPERIMENT_RMSE_DEG if law != r["controller"]) if read
+              for _, t1 in read]
+    return (f"a joint that lags its reference a fixed time (a ruler, not a plant), read from the rig's own T2 and T3 "
+            f"of this law ({delays[0]:.1f}-{delays[1]:.1f} ms; exact on the twin's references at their ticks, over "
+            f"the twin's run lengths), gives T1 {implied[0]:.2f}-{implied[1]:.2f} deg: the rig measured "
+            f"{r['measured']:.2f} (x{ratios[0]:.2f}-x{ratios[1]:.2f} of that), the twin {twin:.2f}"
             + (f". The rig's other laws' T1 are x{min(others):.2f}-x{max(others):.2f} of what their own T2 and T3 "
-               "imply, so it is the rig's cell that departs: its runs met something on T1 that this law's T2 and T3 "
-               "and the other laws' T1 did not; what, the thesis does not say" if others else ""))
+               "imply. So by this ruler the rig's cell is the one that does not follow from its law's T2 and T3; "
+               "whether something disturbed those runs or this law meets something on T1 that the twin lacks, the "
+               "thesis's data do not tell apart" if others else ""))
 
 
 MISS_COLUMNS = ("comparison", "missed_on", "controller", "trajectory", "payload_g", "orientation", "measured", "twin",
@@ -146,9 +160,9 @@ def _rmse_reading(r: dict, f: dict | None, v: Validation, experiment: Sequence[d
     twin_largest = None if peak is None else (
         f"{peak:.1f} (mean over its runs on seeds {f['seeds']})" if fresh_only else
         f"{peak:.1f} (mean over its runs; {big['twin_high']:.1f} at most)")
-    own = None if _loaded(r) or r["trajectory"] != 1 else implied_t1(r["controller"])
     twin = miss["ratio"] * r["measured"]
-    if own and _departs(r["measured"], [t1 for _, t1 in own], twin, high(miss)):
+    own = own_trajectories(r, twin)
+    if own:
         return "own trajectories", _own_trajectories_text(r, own, twin) + also + (
             f". Its largest error was {big['measured']:g} deg, the twin's {twin_largest}"
             if peak is not None else "")
