@@ -235,13 +235,15 @@ class _ServerThread:
         self.thread.join(10)
 
 
-async def _exchange(url: str, outgoing: list[str], wait: float) -> list:
+async def _exchange(url: str, outgoing: list[str], wait: float, until) -> list:
+    """Every message the server sends after ``outgoing``, until ``until(received)`` holds or ``wait`` s pass (a
+    deadline for a server that never gets there, not a window the test counts in)."""
     socket = await tornado.websocket.websocket_connect(url)
     received = []
     for text in outgoing:
         await socket.write_message(text)
     deadline = asyncio.get_running_loop().time() + wait
-    while asyncio.get_running_loop().time() < deadline:
+    while asyncio.get_running_loop().time() < deadline and not until(received):
         try:
             message = await asyncio.wait_for(socket.read_message(), timeout=0.5)
         except TimeoutError:
@@ -260,7 +262,9 @@ def test_server_checks_every_message_and_keeps_running():
         bad = ['{"type": "payload", "grams": 80}', "}{",
                '{"type": "target", "pad": "' + "x" * 5000 + '"}',  # over 4 KiB: it closed the socket once
                '{"type": "target", "angle_deg": 500}']  # answered: the socket stayed open
-        received = asyncio.run(_exchange(url, bad, wait=2.0))
+        received = asyncio.run(_exchange(url, bad, wait=60.0, until=lambda got: len(
+            [m for m in got if isinstance(m, dict) and m.get("type") == "error"]) >= len(bad) and len(
+            [m for m in got if isinstance(m, dict) and m.get("type") == "readout"]) > 10))
     finally:
         server.stop()
     errors = [m["message"] for m in received if isinstance(m, dict) and m.get("type") == "error"]
