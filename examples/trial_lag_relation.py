@@ -33,6 +33,7 @@ import numpy as np
 
 from twin.envs.runner import run_many
 from twin.experiments.reference import THESIS_EXPERIMENT_MAX_ERROR_DEG, THESIS_EXPERIMENT_RMSE_DEG
+from twin.experiments.validate.readings import implied_t1
 from twin.physics.trajectories import Segment, Trajectory, trajectory
 from twin.plants import plant
 from twin.sim.metrics import delay_for_rmse, lagging_metrics
@@ -92,9 +93,9 @@ def main() -> None:
     delay = delay_for(1, rig["pva"][1])
     print("T1's length is not stated; the ruler's T1 is taken over the twin's 3 s. Over other lengths, the rig's laws' "
           "T1 over what their T2 and T3 imply:")
+    read = {law: implied_t1(law) for law in LAWS}  # the rig's delays from T2 and T3, as twin validate reads them
     for length in LENGTHS:
-        ratio = {law: [rig[law][1] / lagging_rmse(1, delay_for(n, rig[law][n]), length=length)[0] for n in (2, 3)]
-                 for law in LAWS}
+        ratio = {law: [rig[law][1] / lagging_rmse(1, d, length=length)[0] for d, _ in read[law]] for law in LAWS}
         others = ratio["ffpva"] + ratio["smc"]
         print(f"  {length:g} s: PVA + DZC x{min(ratio['pva']):.2f}-{max(ratio['pva']):.2f}, FF + PVA and sliding mode "
               f"x{min(others):.2f}-{max(others):.2f}; PVA + DZC's over theirs x{min(ratio['pva']) / max(others):.2f}"
