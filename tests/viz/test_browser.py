@@ -2,7 +2,10 @@
 
 Skips, with its reason, only when chromium is absent; with
 ``TWIN_REQUIRE_BROWSER=1`` (set by ``.ci/run``) a missing browser fails
-instead. Screenshots go to ``artifacts/`` at the repository root.
+instead. Screenshots go to ``artifacts/`` at the repository root; with
+``TWIN_RETAKE_DOCS=1`` two of them also replace the docs' pictures
+(``docs/viewer.png``, ``docs/viewer-compare.png``), so a test run leaves the
+tracked files alone unless asked.
 """
 
 from __future__ import annotations
@@ -60,6 +63,12 @@ def page(browser):
     yield opened
     opened.close()
     assert not errors, f"errors in the page: {errors}"
+
+
+def retake_doc_picture(name: str, doc: str) -> None:
+    """Copy artefact ``name`` over ``docs/<doc>`` when ``TWIN_RETAKE_DOCS=1``; otherwise leave the docs as they are."""
+    if os.environ.get("TWIN_RETAKE_DOCS") == "1":
+        shutil.copy(ARTIFACTS / name, ROOT / "docs" / doc)
 
 
 def screenshot(page, name: str) -> np.ndarray:
@@ -333,7 +342,7 @@ def test_live_page_plots_follows_the_server_and_reflows(live_twin, browser, page
     page.wait_for_timeout(300)
     pixels = screenshot(page, "live-120deg.png")
     assert_scene_rendered(pixels, least=200)  # about 480 brass pixels seen here: half, against pose and driver
-    shutil.copy(ARTIFACTS / "live-120deg.png", ROOT / "docs" / "viewer.png")  # the docs' picture, 1280x720
+    retake_doc_picture("live-120deg.png", "viewer.png")  # the docs' picture, 1280x720
 
     # 800x600 after a resize: the panel stays usable and the 3D view still shows the whole mechanism
     page.set_viewport_size({"width": 800, "height": 600})
@@ -420,7 +429,7 @@ def test_compare_mode_draws_two_joints_and_two_traces(compare_twin, page):
     r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
     teal = (g > 110) & (b > 110) & (r < 0.6 * g)
     assert teal.sum() > 300, f"only {teal.sum()} teal pixels (the compare joint)"
-    shutil.copy(ARTIFACTS / "live-compare.png", ROOT / "docs" / "viewer-compare.png")
+    retake_doc_picture("live-compare.png", "viewer-compare.png")
     # two traces in every line chart, with a legend naming the second
     for chart in ("angle", "error", "duty", "pressure", "valves"):
         assert chart_pixels(page, chart, TEAL) > 20, chart
