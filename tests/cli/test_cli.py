@@ -76,6 +76,7 @@ BASE = ["run", "--controller", "ffpva", "--trajectory", "1"]
     (BASE + ["--plot", "no_such_folder/x.png"], "no_such_folder"),
     (BASE + ["--trace", "ok.csv", "--plot", "no_such_folder/x.png"], "no_such_folder"),
     (BASE + ["--trace", "ok.csv", "--plot", "figure.txt"], "figure.txt"),
+    (BASE + ["--trace", "/dev/null/x.csv"], "'/dev/null' of '/dev/null/x.csv' is a file, not a folder"),
     (BASE + ["--payload", "500"], "500 g"),
     (["demo", "--seeds", "0"], "'0'"),
     (["sweep", "--payload", "heavy", "--out", "x"], "heavy"),
@@ -163,6 +164,9 @@ def test_demo_writes_results_and_summary(tmp_path):
     assert len(rows) == 12  # 3 controllers x 4 trajectories x 1 seed
     pairs = {(r["controller"], int(r["trajectory"])) for r in rows}
     assert pairs == {(c, t) for c in ("pva", "ffpva", "smc") for t in (1, 2, 3, 4)}
+    # the CSV rules of every table (until 2026-12-08 the demo wrote True and 17 digits)
+    assert {r["noise"] for r in rows} == {"true"}
+    assert all(len(r["rmse_deg"].replace(".", "").lstrip("0")) <= 12 for r in rows)
     summary = (out / "summary.md").read_text(encoding="utf-8")
     assert "| controller |" in summary
     header = [line for line in proc.stdout.splitlines() if line.startswith("| controller |")]

@@ -23,7 +23,9 @@ import pytest
 from twin.cli import main
 from twin.exceptions import InvalidAction
 from twin.experiments.reference import ROBUSTNESS_CELLS
-from twin.plants.as_built import ensemble_values
+from twin.plants.as_built import calibrated_values, ensemble_values
+
+COMMITTED_AIR_PCT = calibrated_values()["air_fraction"] * 100  # % of the chamber volume
 
 
 def _one_line_error(capsys, *needles: str) -> str:
@@ -496,7 +498,12 @@ def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, 
     (["whatif", "air", "--out", "OUT", "--air", "2,x"], "--air: percentages separated by commas, got '2,x'"),
     (["whatif", "air", "--out", "OUT", "--air", "25"], "--air: each value must be 0-20 % of the chamber volume"),
     (["whatif", "air", "--out", "OUT", "--air", ",".join(str(k / 10) for k in range(60))], "--air: at most 50 values"),
-    (["whatif", "pva-rate", "--out", "OUT", "--rates", "16"], "a period other than the thesis's 16 ms"),
+    (["whatif", "pva-rate", "--out", "OUT", "--rates", "16"], "--rates: give a period under the thesis's 16 ms"),
+    # Found by a helper's probing (2026-12-08): lists that cannot answer their question ran and answered it
+    (["whatif", "pva-rate", "--out", "OUT", "--rates", "17,32"], "--rates: give a period under the thesis's 16 ms"),
+    (["whatif", "pwm", "--out", "OUT", "--periods", "16"], "--periods: give two periods or more to compare, got '16'"),
+    (["whatif", "air", "--out", "OUT", "--air", f"{COMMITTED_AIR_PCT:.4g}"],
+     f"--air: give a value other than the committed {COMMITTED_AIR_PCT:.4g} %"),
     # Found by probing again (2026-11-27): a range whose step is so small its count overflows was a traceback, and
     # the what-ifs below had no cap (the first took 23 GB before it was killed); whatif payload's refusal came
     # after its folder was made. Each count is the what-if's own: laws or controllers x cells x values x seeds.
@@ -521,6 +528,11 @@ def test_a_sweep_and_a_run_spell_booleans_alike_and_durations_cleanly(tmp_path, 
     (["view", "--controller", "smc", "--trajectory", "1", "--host", ""], "--host: give a host name or address"),
     (["whatif", "gear-load", "--out", ""], "the output folder must be named"),
     (["sweep", "--controller", "ffpva", "--trajectory", "1", "--out", ""], "the output folder must be named"),
+    # empty inputs (a helper's probe, 2026-12-08): the current folder, or "not given"
+    (["sweep", "--seed", "0", "--backend", "ray", "--ray-address", "", "--out", "OUT"], "the address must be named"),
+    (["sweep", "--config", "", "--out", "OUT"], "argument --config: the path must be named, got ''"),
+    (["score", "--measured", "", "--out", "OUT"], "argument --measured: the path must be named, got ''"),
+    (["score", "--measured", "m.csv", "--prediction", "", "--out", "OUT"], "argument --prediction: the path must be"),
     (["view", "--controller", "smc", "--trajectory", "4", "--html", "/proc/a.html"], "cannot write '/proc/a.html'"),
     (["run", "--controller", "ffpva", "--trajectory", "1", "--trace", ".csv"], "must be a file name ending in .csv"),
 ])
@@ -543,6 +555,15 @@ def test_absurd_sizes_empty_names_and_loose_lists_are_refused_before_anything_ru
     assert _exit_code(argv) == 2
     _one_line_error(capsys, words)
     assert list(tmp_path.iterdir()) == []
+
+
+def test_version_names_the_twin_and_mujoco(capsys):
+    assert _exit_code(["--version"]) == 0
+    import mujoco
+
+    from twin.batch.sweep import package_version
+
+    assert capsys.readouterr().out == f"twin {package_version()} (mujoco {mujoco.__version__})\n"
 
 
 def test_a_seed_past_what_a_store_holds_is_refused_by_the_scenario_itself():
@@ -877,6 +898,38 @@ def test_a_ray_address_that_cannot_be_reached_is_one_line_before_anything(tmp_pa
         extra = [e for e in extra if e != item]
     assert main(["sweep", "--seed", "0", *extra, "--out", str(tmp_path / "s")]) == 2
     _one_line_error(capsys, words)
+    assert list(tmp_path.iterdir()) == []
+
+
+@pytest.mark.parametrize("server", ["web", "silent"])
+def test_a_ray_address_that_answers_but_not_as_ray_is_one_line_before_anything(tmp_path, capsys, monkeypatch, server):
+    """Found by a helper's probing (2026-12-08): an address where something else listens (a web server, Ray's
+    dashboard) passed the connection check, and the sweep then sat at 0 of 1 while Ray retried, took 32 s to stop
+    on a Ctrl-C and said "finished scenarios are kept" of none. A server that never replies is refused too."""
+    import http.server
+    import socketserver
+    import threading
+
+    from twin.cli import sweep
+
+    class Silent(socketserver.BaseRequestHandler):
+        def handle(self):
+            self.request.recv(1024)
+            time.sleep(1.0)  # past the timeout below, then close
+
+    handler = http.server.SimpleHTTPRequestHandler if server == "web" else Silent
+    monkeypatch.setattr(http.server.SimpleHTTPRequestHandler, "log_message", lambda *a: None)
+    monkeypatch.setattr(sweep, "RAY_CONNECT_TIMEOUT", 0.3)
+    monkeypatch.delenv("RAY_ADDRESS", raising=False)
+    with socketserver.ThreadingTCPServer(("127.0.0.1", 0), handler) as listening:
+        threading.Thread(target=listening.serve_forever, daemon=True).start()
+        address = f"127.0.0.1:{listening.server_address[1]}"
+        try:
+            assert main(["sweep", "--seed", "0", "--backend", "ray", "--ray-address", address,
+                         "--out", str(tmp_path / "s")]) == 2
+        finally:
+            listening.shutdown()
+    _one_line_error(capsys, f"--ray-address: {address} answers, but not as a Ray cluster does")
     assert list(tmp_path.iterdir()) == []
 
 

@@ -78,7 +78,7 @@ def test_whatif_lift_says_so_when_no_pressure_tried_lifts_the_payload(tmp_path, 
 
 
 @pytest.mark.parametrize("study, args, total", [
-    ("pwm", ["--periods", "8", "--seeds", "1"], 2 * 2 * 1 * 1),  # controllers x trajectories x periods x seeds
+    ("pwm", ["--periods", "8,16", "--seeds", "1"], 2 * 2 * 2 * 1),  # controllers x trajectories x periods x seeds
     ("payload", ["--payloads", "0", "--seeds", "1", "--workers", "1"], 2 * 1 * 2 * 1),  # x orientations
     pytest.param("supply", ["--seeds", "1"], 3 * 2 * 2 * 1, marks=pytest.mark.slow),  # supply models x ...
     pytest.param("gear-load", [], 3 * 4 * 2 * 2, marks=pytest.mark.slow),  # x trajectories x payloads x kPa

@@ -405,3 +405,27 @@ def test_runs_simulated_in_parts_give_the_numbers_of_one_batch(monkeypatch):
     assert everything() == whole
     monkeypatch.setattr(simulation, "RUN_PART", 1)
     assert everything() == whole
+
+
+def test_whatif_payload_counts_failed_runs_and_exits_1(tmp_path, capsys, monkeypatch):
+    """A failed run is not a payload the joint cannot follow: the answer counts and names it (the first
+    line of its reason), marks its cell, and the command exits 1 (until 2026-12-08 it read as "never follows" and exited 0)."""
+    from twin.experiments.whatifs import payload
+
+    real = payload.run_sweep
+
+    def one_failed(points, **kwargs):
+        outcome = real(points, **kwargs)
+        first = outcome.records[0]
+        first.update(status="failed", reason="InvalidScenario: broken\nsecond line", rmse_deg=math.nan)
+        return outcome
+
+    monkeypatch.setattr(payload, "run_sweep", one_failed)
+    out = tmp_path / "p"
+    assert main(["whatif", "payload", "--out", str(out), "--payloads", "0", "--seeds", "1", "--trajectory", "2",
+                 "--workers", "1"]) == 1
+    printed = capsys.readouterr().out
+    assert "1 of 4 runs failed" in printed and printed.count("InvalidScenario: broken") == 1
+    assert "second line" not in printed
+    lines = [line for line in printed.splitlines() if line.startswith(("ffpva ", "smc "))]
+    assert len(lines) == 4 and sum("(runs failed at 0 g)" in line for line in lines) == 1

@@ -34,7 +34,8 @@ def test_an_unknown_controller_is_still_refused():
 @pytest.mark.parametrize("given, message", [
     ({"trajectory": 5}, "unknown trajectory 5"),
     ({"trajectory": True}, "unknown trajectory True"),  # True == 1
-    ({"payload": -1e-3}, "payload must be between 0 and 200 g, got -1 g"),
+    ({"payload": -1e-3}, "payload must be 0 or between 0.001 and 200 g, got -1 g"),
+    ({"payload": 1e-323}, "payload must be 0 or between 0.001 and 200 g, got 9.881312917e-321 g"),
     ({"payload": math.nan}, "got nan g"),
     ({"payload": "6.5"}, "got '6.5'"),
     ({"payload": 10**400}, r"got 10000000000000000000\.\.\.$"),  # OverflowError until stop 60

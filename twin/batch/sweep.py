@@ -54,7 +54,8 @@ class WorkerLost(TwinError):
     """A worker process died mid-sweep (killed, or out of memory)."""
 
 
-def _package_version() -> str:
+def package_version() -> str:
+    """The installed package's version, or the source tree's pyproject.toml's ("unknown" without either)."""
     try:
         return importlib.metadata.version("hydraulic-joint-twin")
     except importlib.metadata.PackageNotFoundError:  # run from a source tree
@@ -79,7 +80,7 @@ def code_version(plants: Mapping | None = None) -> str:
     trajectories = [trajectory(n, spur_radius=NOMINAL_PARAMS.gears.spur_radius) for n in (1, 2, 3, 4)]
     presets = PLANTS if plants is None else plants
     params = hashlib.sha256(repr((presets, trajectories)).encode() + MODEL_PATH.read_bytes()).hexdigest()[:16]
-    return (f"store {STORE_FORMAT}, twin {_package_version()}, mujoco {mujoco.__version__}, "
+    return (f"store {STORE_FORMAT}, twin {package_version()}, mujoco {mujoco.__version__}, "
             f"numpy {np.__version__}, numba {numba.__version__}, params {params}")
 
 

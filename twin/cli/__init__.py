@@ -28,8 +28,25 @@ EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell reports a reader that went a
 COMMANDS = (demo, bench, sweep, experiments, run, calibrate, validate, score, view)
 
 
+class _Version(argparse.Action):
+    """``twin --version``: the package's and MuJoCo's versions, imported only when asked (a probe, 2026-12-08)."""
+
+    def __init__(self, option_strings, dest, **kwargs):
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS,
+                         help="print the twin's and MuJoCo's versions and exit")
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        import mujoco
+
+        from twin.batch.sweep import package_version
+
+        print(f"twin {package_version()} (mujoco {mujoco.__version__})")  # stdout, as argparse's own version
+        parser.exit(0)
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = Parser(prog="twin", description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action=_Version)
     sub = parser.add_subparsers(dest="command", required=True, parser_class=Parser)
     for command in COMMANDS:
         command.add_parser(sub)

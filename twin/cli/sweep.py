@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import importlib.util
 import os
-import pathlib
 import sys
 
 from twin.cli.common import EXIT_INTERRUPTED, check_out_folder, output_folder
@@ -53,12 +52,18 @@ def _cmd_sweep(args: argparse.Namespace) -> int:
 
 
 RAY_CONNECT_TIMEOUT = 5.0  # s to reach a cluster's head before the sweep is refused (Ray itself retries for minutes)
+HTTP2_PREFACE = b"PRI * HTTP/2.0\r\n\r\nSM\r\n\r\n" + bytes(3) + b"\x04" + bytes(5)  # and an empty SETTINGS frame
+HTTP2_SETTINGS = 4  # frame type: a gRPC server's first frame (RFC 9113 3.4)
 
 
 def check_ray_address(address: str, source: str = "--ray-address") -> None:
     """``--ray-address`` ``HOST:PORT`` (or ``ray://HOST:PORT``) must answer a TCP connection within
     :data:`RAY_CONNECT_TIMEOUT`, else a one-line error before anything is written: Ray's own connect retries
-    for minutes with no error (found by probing, 2026-11-27). ``auto`` and ``local`` are left to Ray."""
+    for minutes with no error (found by probing, 2026-11-27). It must also answer as gRPC does, which Ray's
+    head (its GCS) and its client server speak: an HTTP/2 preface gets a SETTINGS frame back. Something else
+    on the port (Ray's dashboard, a web server) left the sweep at 0 of 1 for minutes and slow to stop
+    (found by a helper's probing, 2026-12-08; Ray 2.60's GCS checked by hand to answer so). ``auto`` and
+    ``local`` are left to Ray."""
     import socket
 
     if address in ("auto", "local"):
@@ -67,9 +72,20 @@ def check_ray_address(address: str, source: str = "--ray-address") -> None:
     if not host or not port.isdigit() or not 0 < int(port) < 65536:
         raise InvalidScenario(f"{source}: HOST:PORT, ray://HOST:PORT, auto or local, got {address!r}")
     try:
-        socket.create_connection((host.strip("[]"), int(port)), timeout=RAY_CONNECT_TIMEOUT).close()
+        connection = socket.create_connection((host.strip("[]"), int(port)), timeout=RAY_CONNECT_TIMEOUT)
     except OSError as error:
         raise InvalidScenario(f"{source}: cannot reach a Ray cluster at {address} ({error.strerror or error})") from None
+    with connection:
+        reply = b""
+        try:
+            connection.sendall(HTTP2_PREFACE)
+            while len(reply) < 9 and (chunk := connection.recv(9 - len(reply))):
+                reply += chunk
+        except OSError:  # no reply in time, or the connection dropped
+            pass
+    if len(reply) < 9 or reply[3] != HTTP2_SETTINGS:
+        raise InvalidScenario(f"{source}: {address} answers, but not as a Ray cluster does (no gRPC reply); a "
+                              "head's address is its GCS port (6379 unless set), not its dashboard's")
 
 
 OUTPUTS = ("results.csv", "results.parquet", "summary.csv", "rmse.png")  # the figure last
@@ -124,10 +140,11 @@ def add_parser(sub) -> None:
         numbers = "" if name in ("controller", "orientation", "plant") else "; also start:stop:step"
         sweep.add_argument("--" + name.replace("_", "-"), dest=name, metavar="LIST",
                            help=f"comma list of {what}{numbers}")
-    sweep.add_argument("--config", type=pathlib.Path, metavar="GRID.toml", help="axes from a TOML file")
+    sweep.add_argument("--config", type=arguments.named_path, metavar="GRID.toml", help="axes from a TOML file")
     sweep.add_argument("--out", type=arguments.out_dir, required=True, metavar="DIR", help="results folder (created)")
     sweep.add_argument("--workers", type=arguments.positive_int, default=None,
                        help="processes (default: all cores); with Ray, CPUs to size chunks for (default: the cluster's)")
     sweep.add_argument("--backend", choices=("local", "ray"), default="local")
-    sweep.add_argument("--ray-address", default=None, help="Ray cluster address (default: RAY_ADDRESS or local)")
+    sweep.add_argument("--ray-address", type=arguments.ray_address, default=None,
+                       help="Ray cluster address (default: RAY_ADDRESS or local)")
     sweep.set_defaults(func=_cmd_sweep)

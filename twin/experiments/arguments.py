@@ -24,6 +24,8 @@ def writable_file(suffix: str):
         path = pathlib.Path(text)
         if path.suffix.lower() != suffix or not path.stem:
             raise argparse.ArgumentTypeError(f"{text!r} must be a file name ending in {suffix}")
+        if path.parent.exists() and not path.parent.is_dir():
+            raise argparse.ArgumentTypeError(f"{str(path.parent)!r} of {text!r} is a file, not a folder")
         if not path.parent.is_dir():
             raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} of {text!r} does not exist")
         if path.is_dir():
@@ -71,6 +73,21 @@ def out_dir(text: str) -> pathlib.Path:
     if path.exists() and not path.is_dir():
         raise argparse.ArgumentTypeError(f"{text!r} is a file, not a folder")
     return path
+
+
+def named_path(text: str) -> pathlib.Path:
+    """An input file or folder: named, since ``pathlib.Path("")`` is the current folder (a probe, 2026-12-08)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("the path must be named, got ''")
+    return pathlib.Path(text)
+
+
+def ray_address(text: str) -> str:
+    """``--ray-address``: named; an empty one read as "not given" and ran on RAY_ADDRESS or a local Ray."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError("the address must be named (HOST:PORT, ray://HOST:PORT, auto or local), "
+                                         "got ''")
+    return text
 
 
 grams = checked(float, lambda v: v >= 0, "payload must be a non-negative number of grams")

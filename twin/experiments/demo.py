@@ -14,7 +14,6 @@ this run's files is touched.
 
 from __future__ import annotations
 
-import csv
 import pathlib
 import re
 import sys
@@ -22,7 +21,7 @@ import sys
 import numpy as np
 from tqdm import tqdm
 
-from twin.batch.tables import counted, signed
+from twin.batch.tables import counted, signed, write_csv
 from twin.envs.runner import run_many
 from twin.experiments.base import staged, tell_undrawn
 from twin.experiments.reference import (
@@ -142,16 +141,12 @@ def run_demo(*, out: pathlib.Path, seeds: int = 5, plots: bool = True) -> int:
     rows = summary_rows(results)
     table = markdown_table(rows) + "\n\n" + rest_error_table(results)
     with staged(out, "demo") as stage:
-        with open(stage.folder / "results.csv", "w", newline="") as handle:
-            writer = None
-            for result in results:
-                record = report.summary(result)
-                record["warnings"] = ";".join(record["warnings"])
-                record["rest_errors_deg"] = ";".join(f"{e:.4f}" for e in record["rest_errors_deg"])
-                if writer is None:
-                    writer = csv.DictWriter(handle, fieldnames=list(record))
-                    writer.writeheader()
-                writer.writerow(record)
+        records = []  # the CSV rules of every table (true / false, 12 significant digits): write_csv's
+        for result in results:
+            record = report.summary(result)
+            record["rest_errors_deg"] = ";".join(f"{e:.4f}" for e in record["rest_errors_deg"])
+            records.append(record)
+        write_csv(records, list(records[0]), stage.folder / "results.csv")
         (stage.folder / "summary.md").write_text(f"{SUMMARY_TITLE} ('thesis' plant, {counted(seeds, 'seed')})\n\n{table}\n")
         stage.names += list(OUTPUTS)
         if plots:

@@ -53,6 +53,7 @@ import numpy as np
 from twin.batch.grid import plain_number
 from twin.batch.tables import write_csv
 from twin.exceptions import InvalidScenario
+from twin.experiments import arguments
 from twin.experiments.base import Experiment, Outcome, drawn
 from twin.experiments.calibrate import THESIS_RUNS
 from twin.experiments.reference import THESIS_EXPERIMENT_RMSE_DEG
@@ -176,15 +177,16 @@ def _read(path, what: str) -> tuple[list[str], list[tuple[int, dict]]]:
 
 
 def _number(text: str, where: str, column: str, *, low: float = 0.0, high: float = math.inf,
-            hint: str = "") -> float:
-    """``text`` as a finite number from ``low`` to ``high``, else a one-line error (ending in ``hint``)."""
+            hint: str = "", above: bool = False) -> float:
+    """``text`` as a finite number from ``low`` (past it if ``above``) to ``high``, else a one-line error
+    (ending in ``hint``)."""
     try:
         value = plain_number(text)
     except ValueError:
         value = math.nan
-    if not math.isfinite(value) or not low <= value <= high:
-        bound = ("a finite number" if low == -math.inf else f"a number of at least {low:g}" if high == math.inf
-                 else f"a number from {low:.3g} to {high:g}")
+    if not math.isfinite(value) or not low <= value <= high or (above and value == low):
+        bound = ("a finite number" if low == -math.inf else f"a number above {low:g}, at most {high:g}" if above
+                 else f"a number of at least {low:g}" if high == math.inf else f"a number from {low:.3g} to {high:g}")
         raise InvalidScenario(f"{where}: {column} must be {bound}, got {text!r}{hint}")
     return value
 
@@ -253,7 +255,9 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
         stalled = row.get("stalled_runs") or None
         found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG,
                                       high=LARGEST_DEG, hint=degrees),
-                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg", high=LARGEST_DEG), "runs": runs,
+                      # above 0: the standard errors divide by it (a 0 made every z infinite until 2026-12-08)
+                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg", high=LARGEST_DEG, above=True),
+                      "runs": runs,
                       "stalled": None if stalled is None else _whole(stalled, where, "stalled_runs", 0, runs)}
     _complete(found, f"measured file {str(path)!r}")
     if runs_given and len(runs_given) != len(found):  # a blank would silently be five beside stated tens
@@ -529,10 +533,10 @@ class ScoreExperiment(Experiment):
     help = "the blind T3 prediction against measured T3 cells, by rules fixed before the data"
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
-        parser.add_argument("--measured", type=pathlib.Path, required=True, metavar="FILE",
+        parser.add_argument("--measured", type=arguments.named_path, required=True, metavar="FILE",
                             help="CSV of the measured T3 cells: " + ", ".join(MEASURED_COLUMNS) +
                                  " (optional: trajectory, runs, stalled_runs)")
-        parser.add_argument("--prediction", type=pathlib.Path, default=None, metavar="DIR",
+        parser.add_argument("--prediction", type=arguments.named_path, default=None, metavar="DIR",
                             help="a twin validate --out folder (default: the committed prediction)")
 
         parser.add_argument("--unregistered", action="store_true",

@@ -232,10 +232,14 @@ class AirWhatIf(Experiment):
                                                                          "twin validate)")
 
     def check(self, args: argparse.Namespace) -> None:
-        from twin.plants.as_built import calibration_cost_line
+        from twin.plants.as_built import calibrated_values, calibration_cost_line
 
         args.air_values = parse_air(args.air)
         calibration_cost_line()  # a calibration file with a cost and its noise, before anything is written
+        committed = calibrated_values()["air_fraction"] * 100
+        if all(v == committed for v in args.air_values):  # the committed value alone: nothing to compare
+            raise InvalidScenario(f"--air: give a value other than the committed {_pct(committed)} %, which is "
+                                  f"always run, got {args.air!r}")
         refuse_oversized((len(args.air_values) + 1) * runs_per_value(args.seeds), "--air x --seeds")
 
     def run(self, args: argparse.Namespace, out: pathlib.Path) -> Outcome:

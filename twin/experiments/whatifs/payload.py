@@ -32,6 +32,7 @@ def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory:
         bar.reset(total=len(points))
     records = run_sweep(points, out=out, workers=workers, progress=None if bar is None else counting(bar)).records
     rows = summarise(records)
+    failed = [r for r in records if r["status"] != "ok"]
     lines = []
     for controller in ("ffpva", "smc"):
         for orientation in ("horizontal", "vertical"):
@@ -40,12 +41,18 @@ def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory:
             following = [r for r in group if r["failed"] == 0 and r["max_error_deg"] <= FOLLOW_LIMIT_DEG]
             last_ok = max((r["payload_g"] for r in following), default=None)
             first_bad = next((r["payload_g"] for r in group
-                              if r["failed"] or r["max_error_deg"] > FOLLOW_LIMIT_DEG), None)
+                              if not r["failed"] and r["max_error_deg"] > FOLLOW_LIMIT_DEG), None)
             reach = (f"follows T{trajectory} up to {last_ok:g} g" if last_ok is not None else "never follows")
             reach += f", not at {first_bad:g} g" if first_bad is not None else " (the whole range)"
+            broken = [f"{r['payload_g']:g}" for r in group if r["failed"]]
+            reach += f" (runs failed at {', '.join(broken)} g)" if broken else ""
             rmse = ", ".join(f"{r['payload_g']:g} g: {r['rmse_mean_deg']:.2f}" for r in group[:: max(1, len(group) // 4)])
             lines.append(f"{controller} {orientation}: {reach}; RMSE (deg) {rmse}")
-    return Outcome(rows, "\n".join(lines))
+    if failed:  # a failed run is not a payload the joint cannot follow: say so, and exit 1
+        lines.append(f"{len(failed)} of {len(records)} runs failed (their RMSE is nan, and where the joint "
+                     f"follows is not known there); the first: {failed[0]['key']}: "
+                     f"{str(failed[0]['reason']).splitlines()[0]}")
+    return Outcome(rows, "\n".join(lines), failed=len(failed))
 
 
 class PayloadWhatIf(Experiment):

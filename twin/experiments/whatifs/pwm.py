@@ -10,6 +10,7 @@ import pathlib
 from collections.abc import Sequence
 
 from twin.batch.tables import summarise
+from twin.exceptions import InvalidScenario
 from twin.experiments.base import Experiment, Outcome
 from twin.experiments.whatifs.common import (
     add_common_arguments,
@@ -106,6 +107,8 @@ class PwmWhatIf(Experiment):
 
     def check(self, args: argparse.Namespace) -> None:
         args.period_values = list_flag(args, "--periods", "periods", "pwm_period_ms")
+        if len(set(args.period_values)) < 2:  # one period cannot show what the period changes
+            raise InvalidScenario(f"--periods: give two periods or more to compare, got {args.periods!r}")
         refuse_oversized(len(MODEL_BASED_CONTROLLERS) * len(TRAJECTORIES) * args.seeds * len(set(args.period_values)),
                          "--periods x --seeds")
 
