@@ -620,7 +620,9 @@ def test_a_sweep_joins_a_ray_head_by_its_address(tmp_path, one_ray_at_a_time):
     head through: ``ray start --head --block`` on a free port, then ``--ray-address 127.0.0.1:PORT``. The head
     runs in its own session and is stopped by its group, not by ``ray stop`` (which would stop every Ray here)."""
     pytest.importorskip("ray")
+    import shutil
     import socket
+    import tempfile
 
     ray_cli = pathlib.Path(sys.executable).with_name("ray")
     if not ray_cli.exists():
@@ -630,9 +632,14 @@ def test_a_sweep_joins_a_ray_head_by_its_address(tmp_path, one_ray_at_a_time):
         port = probe.getsockname()[1]
     # without a token: Ray 2.59+ makes one for a local head, which a driver here did not find (a test's choice)
     env = {**{key: value for key, value in os.environ.items() if key != "RAY_ADDRESS"}, "RAY_AUTH_MODE": "disabled"}
+    # its own temp dir: `ray start` writes the head's address to TEMP/ray_current_cluster, which only `ray stop`
+    # removes; in the default /tmp/ray it sent later local-Ray sweeps to the stopped head (a review, 2026-12-08).
+    # Short, for Ray's socket paths.
+    ray_temp = tempfile.mkdtemp(prefix="twr")
     head = subprocess.Popen([str(ray_cli), "start", "--head", "--block", "--port", str(port), "--num-cpus", "1",
-                             "--include-dashboard", "false", "--disable-usage-stats"], cwd=tmp_path, env=env,
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+                             "--include-dashboard", "false", "--disable-usage-stats", "--temp-dir", ray_temp],
+                            cwd=tmp_path, env=env, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL,
+                            start_new_session=True)
     try:
         deadline = time.monotonic() + 120
         while True:
@@ -649,6 +656,7 @@ def test_a_sweep_joins_a_ray_head_by_its_address(tmp_path, one_ray_at_a_time):
     finally:
         os.killpg(head.pid, signal.SIGTERM)
         head.wait(timeout=60)
+        shutil.rmtree(ray_temp, ignore_errors=True)
 
 
 def test_the_printed_summary_keeps_its_columns_under_long_names():

@@ -921,16 +921,19 @@ def test_a_ray_address_that_answers_but_not_as_ray_is_one_line_before_anything(t
     monkeypatch.setattr(http.server.SimpleHTTPRequestHandler, "log_message", lambda *a: None)
     monkeypatch.setattr(sweep, "RAY_CONNECT_TIMEOUT", 0.3)
     monkeypatch.delenv("RAY_ADDRESS", raising=False)
+    monkeypatch.delenv("RAY_USE_TLS", raising=False)
     with socketserver.ThreadingTCPServer(("127.0.0.1", 0), handler) as listening:
         threading.Thread(target=listening.serve_forever, daemon=True).start()
         address = f"127.0.0.1:{listening.server_address[1]}"
         try:
             assert main(["sweep", "--seed", "0", "--backend", "ray", "--ray-address", address,
                          "--out", str(tmp_path / "s")]) == 2
+            _one_line_error(capsys, f"--ray-address: {address} answers, but not as a Ray cluster does")
+            assert list(tmp_path.iterdir()) == []
+            monkeypatch.setenv("RAY_USE_TLS", "1")  # a TLS cluster wants a handshake first: the connection alone
+            sweep.check_ray_address(address)
         finally:
             listening.shutdown()
-    _one_line_error(capsys, f"--ray-address: {address} answers, but not as a Ray cluster does")
-    assert list(tmp_path.iterdir()) == []
 
 
 def test_ray_failing_to_connect_is_not_read_as_a_file_that_cannot_be_written(monkeypatch):

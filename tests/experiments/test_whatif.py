@@ -429,3 +429,6 @@ def test_whatif_payload_counts_failed_runs_and_exits_1(tmp_path, capsys, monkeyp
     assert "second line" not in printed
     lines = [line for line in printed.splitlines() if line.startswith(("ffpva ", "smc "))]
     assert len(lines) == 4 and sum("(runs failed at 0 g)" in line for line in lines) == 1
+    failed_cell = next(line for line in lines if "runs failed" in line)  # not read as a payload it cannot follow
+    assert "where it follows is not known" in failed_cell and "never follows" not in failed_cell
+    assert "the whole range" not in failed_cell

@@ -92,10 +92,16 @@ def test_solref_is_twice_the_timestep():
         np.testing.assert_allclose(model.eq_solref[:, 0], 2 * timestep)
 
 
-@pytest.mark.parametrize("payload", [-1e-3, float("nan"), 1.0])
+@pytest.mark.parametrize("payload", [-1e-3, float("nan"), 1.0, 1e-323, 9.99e-7])
 def test_bad_payload_is_rejected(payload):
-    with pytest.raises(InvalidScenario):
+    """Under 1 mg too (since 2026-12-08): MuJoCo refused 1e-323 kg in the model file in three lines."""
+    with pytest.raises(InvalidScenario, match="payload must be 0 or between 0.001 and 200 g, got "):
         compile_joint(payload_mass=payload)
+
+
+@pytest.mark.parametrize("payload", [0.0, 1e-6, 0.2])
+def test_the_payload_range_ends_are_taken(payload):
+    compile_joint(payload_mass=payload)
 
 
 def test_referred_mass_closed_form_is_the_multibody_inertia_along_the_rack():

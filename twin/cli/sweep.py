@@ -6,6 +6,7 @@ import argparse
 import importlib.util
 import os
 import sys
+import time
 
 from twin.cli.common import EXIT_INTERRUPTED, check_out_folder, output_folder
 from twin.exceptions import InvalidScenario
@@ -62,8 +63,9 @@ def check_ray_address(address: str, source: str = "--ray-address") -> None:
     for minutes with no error (found by probing, 2026-11-27). It must also answer as gRPC does, which Ray's
     head (its GCS) and its client server speak: an HTTP/2 preface gets a SETTINGS frame back. Something else
     on the port (Ray's dashboard, a web server) left the sweep at 0 of 1 for minutes and slow to stop
-    (found by a helper's probing, 2026-12-08; Ray 2.60's GCS checked by hand to answer so). ``auto`` and
-    ``local`` are left to Ray."""
+    (found by a helper's probing, 2026-12-08; Ray 2.60's GCS checked by hand to answer so). A cluster on TLS
+    (``RAY_USE_TLS``, which Ray reads too) wants a TLS handshake first: there only the connection is checked.
+    The reply is waited for :data:`RAY_CONNECT_TIMEOUT` in all. ``auto`` and ``local`` are left to Ray."""
     import socket
 
     if address in ("auto", "local"):
@@ -76,16 +78,21 @@ def check_ray_address(address: str, source: str = "--ray-address") -> None:
     except OSError as error:
         raise InvalidScenario(f"{source}: cannot reach a Ray cluster at {address} ({error.strerror or error})") from None
     with connection:
-        reply = b""
+        if os.environ.get("RAY_USE_TLS", "0").lower() in ("1", "true"):
+            return
+        reply, deadline = b"", time.monotonic() + RAY_CONNECT_TIMEOUT
         try:
             connection.sendall(HTTP2_PREFACE)
-            while len(reply) < 9 and (chunk := connection.recv(9 - len(reply))):
+            while len(reply) < 9:
+                connection.settimeout(max(1e-3, deadline - time.monotonic()))  # one budget, not one per recv
+                if not (chunk := connection.recv(9 - len(reply))):
+                    break
                 reply += chunk
         except OSError:  # no reply in time, or the connection dropped
             pass
     if len(reply) < 9 or reply[3] != HTTP2_SETTINGS:
         raise InvalidScenario(f"{source}: {address} answers, but not as a Ray cluster does (no gRPC reply); a "
-                              "head's address is its GCS port (6379 unless set), not its dashboard's")
+                              "head's address is its GCS port (6379 unless set), not its dashboard's; on TLS, set RAY_USE_TLS=1")
 
 
 OUTPUTS = ("results.csv", "results.parquet", "summary.csv", "rmse.png")  # the figure last

@@ -256,7 +256,8 @@ def read_measured(path: pathlib.Path) -> dict[tuple, dict]:
         found[key] = {"mean": _number(row["rmse_mean_deg"], where, "rmse_mean_deg", low=SMALLEST_MEAN_DEG,
                                       high=LARGEST_DEG, hint=degrees),
                       # above 0: the standard errors divide by it (a 0 made every z infinite until 2026-12-08)
-                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg", high=LARGEST_DEG, above=True),
+                      "std": _number(row["rmse_std_deg"], where, "rmse_std_deg", high=LARGEST_DEG, above=True,
+                                     hint=" (a std a table rounds to 0 is under half its last digit: give that)"),
                       "runs": runs,
                       "stalled": None if stalled is None else _whole(stalled, where, "stalled_runs", 0, runs)}
     _complete(found, f"measured file {str(path)!r}")

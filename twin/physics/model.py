@@ -35,6 +35,12 @@ MODEL_PATH = importlib.resources.files("models") / "joint.xml"  # package data o
 MECHANISM_JOINTS = ("rack_a", "rack_b", "pinion", "spur")
 MAX_PAYLOAD = 0.2  # kg; far past what 700 kPa can lift, a guard against unit mistakes
 MIN_PAYLOAD = 1e-6  # kg; a payload is 0 or at least 1 mg: MuJoCo refuses a mass as small as 1e-323 kg in the model file
+PAYLOAD_RANGE = f"0 or between {MIN_PAYLOAD * 1e3:g} and {MAX_PAYLOAD * 1e3:g} g"  # as the errors say it
+
+
+def payload_allowed(mass: float) -> bool:
+    """Whether ``mass`` (kg, a real number) is a payload the model takes: 0, or MIN_PAYLOAD to MAX_PAYLOAD."""
+    return math.isfinite(mass) and (mass == 0.0 or MIN_PAYLOAD <= mass <= MAX_PAYLOAD)
 THESIS_PAYLOADS = (6.5e-3, 13.5e-3)  # kg at the link tip: the thesis's two payloads (SPEC §2, §9)
 
 
@@ -85,9 +91,8 @@ def _mjcf():
 def build_mjcf(*, params: JointParams = NOMINAL_PARAMS, payload_mass: float = 0.0,
                orientation: Orientation = Orientation.HORIZONTAL, timestep: float = 1e-3):
     """The joint as a ``dm_control.mjcf`` element tree, ready to compile."""
-    if not (0.0 <= payload_mass <= MAX_PAYLOAD) or not math.isfinite(payload_mass) or 0 < payload_mass < MIN_PAYLOAD:
-        raise InvalidScenario(f"payload must be 0 or in [{MIN_PAYLOAD * 1e3:g}, {MAX_PAYLOAD * 1e3:g}] g, "
-                              f"got {payload_mass * 1e3:.10g} g")
+    if not payload_allowed(payload_mass):
+        raise InvalidScenario(f"payload must be {PAYLOAD_RANGE}, got {payload_mass * 1e3:.10g} g")
     if not (0 < timestep <= 2e-3):
         raise InvalidScenario(f"timestep must be in (0, 2 ms], got {timestep}")
     with importlib.resources.as_file(MODEL_PATH) as path:

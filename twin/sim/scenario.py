@@ -9,7 +9,7 @@ import numbers
 import numpy as np
 
 from twin.exceptions import InvalidScenario
-from twin.physics.model import MAX_PAYLOAD, MIN_PAYLOAD, Orientation
+from twin.physics.model import PAYLOAD_RANGE, Orientation, payload_allowed
 from twin.plants import Plant, plant
 
 CONTROLLER_NAMES = ("pva", "ffpva", "smc")
@@ -59,9 +59,8 @@ class Scenario:
         if isinstance(self.trajectory, bool) or not isinstance(self.trajectory, numbers.Integral) \
                 or self.trajectory not in TRAJECTORY_NUMBERS:  # True == 1 and 1.0 == 1: not trajectories
             raise InvalidScenario(f"unknown trajectory {self.trajectory!r}: choose 1, 2, 3 or 4")
-        if not _finite(self.payload) or not 0 <= self.payload <= MAX_PAYLOAD or 0 < self.payload < MIN_PAYLOAD:
-            raise InvalidScenario(f"payload must be 0 or between {MIN_PAYLOAD * 1e3:g} and {MAX_PAYLOAD * 1e3:g} g, "
-                                  f"got {_shown(self.payload, 1e3, 'g')}")
+        if not _finite(self.payload) or not payload_allowed(self.payload):
+            raise InvalidScenario(f"payload must be {PAYLOAD_RANGE}, got {_shown(self.payload, 1e3, 'g')}")
         if not isinstance(self.orientation, Orientation):
             raise InvalidScenario(f"orientation must be an Orientation, got {self.orientation!r}")
         if self.pwm_period is not None:

@@ -236,9 +236,9 @@ class AirWhatIf(Experiment):
 
         args.air_values = parse_air(args.air)
         calibration_cost_line()  # a calibration file with a cost and its noise, before anything is written
-        committed = calibrated_values()["air_fraction"] * 100
-        if all(v == committed for v in args.air_values):  # the committed value alone: nothing to compare
-            raise InvalidScenario(f"--air: give a value other than the committed {_pct(committed)} %, which is "
+        committed = calibrated_values()["air_fraction"]
+        if all(v / 100 == committed for v in args.air_values):  # as air_study tells values apart: nothing to compare
+            raise InvalidScenario(f"--air: give a value other than the committed {_pct(committed * 100)} %, which is "
                                   f"always run, got {args.air!r}")
         refuse_oversized((len(args.air_values) + 1) * runs_per_value(args.seeds), "--air x --seeds")
 

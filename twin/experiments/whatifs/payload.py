@@ -38,13 +38,16 @@ def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory:
         for orientation in ("horizontal", "vertical"):
             group = sorted((r for r in rows if r["controller"] == controller and r["orientation"] == orientation),
                            key=lambda r: r["payload_g"])
-            following = [r for r in group if r["failed"] == 0 and r["max_error_deg"] <= FOLLOW_LIMIT_DEG]
-            last_ok = max((r["payload_g"] for r in following), default=None)
-            first_bad = next((r["payload_g"] for r in group
-                              if not r["failed"] and r["max_error_deg"] > FOLLOW_LIMIT_DEG), None)
-            reach = (f"follows T{trajectory} up to {last_ok:g} g" if last_ok is not None else "never follows")
-            reach += f", not at {first_bad:g} g" if first_bad is not None else " (the whole range)"
+            ran = [r for r in group if not r["failed"]]  # a payload with a failed run: where it follows is unknown
             broken = [f"{r['payload_g']:g}" for r in group if r["failed"]]
+            last_ok = max((r["payload_g"] for r in ran if r["max_error_deg"] <= FOLLOW_LIMIT_DEG), default=None)
+            first_bad = next((r["payload_g"] for r in ran if r["max_error_deg"] > FOLLOW_LIMIT_DEG), None)
+            if ran:
+                reach = (f"follows T{trajectory} up to {last_ok:g} g" if last_ok is not None else "never follows")
+                reach += (f", not at {first_bad:g} g" if first_bad is not None else
+                          " (every payload whose runs ran)" if broken else " (the whole range)")
+            else:
+                reach = "where it follows is not known"
             reach += f" (runs failed at {', '.join(broken)} g)" if broken else ""
             rmse = ", ".join(f"{r['payload_g']:g} g: {r['rmse_mean_deg']:.2f}" for r in group[:: max(1, len(group) // 4)])
             lines.append(f"{controller} {orientation}: {reach}; RMSE (deg) {rmse}")
