@@ -22,6 +22,7 @@ def _bar(err: str, label: str) -> list[tuple[int, int]]:
     renders = [r for r in re.split(r"[\r\n]", err) if r.startswith(f"{label}:")]
     assert renders, err
     assert not [r for r in renders if COUNT_WITHOUT_TOTAL.search(r)], renders
+    assert all(COUNT_WITH_TOTAL.search(r) for r in renders), renders  # nor "0scenario" before it (until 2026-12-08)
     return [(int(m[1]), int(m[2])) for m in map(COUNT_WITH_TOTAL.search, renders) if m]
 
 

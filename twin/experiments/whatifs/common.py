@@ -72,8 +72,10 @@ def batch_progress(bar, count: int):
 
 @contextlib.contextmanager
 def progress_bar(name: str):
-    """A scenario-counting progress bar on stderr, labelled ``name``."""
+    """A scenario-counting progress bar on stderr, labelled ``name``. Drawn first when its total is given
+    (``reset(total=...)``) or at its first count: not as "0scenario" before it knows its total (the ``delay``),
+    which a log kept as a stray line (a probe, 2026-12-08)."""
     from tqdm import tqdm
 
-    with tqdm(unit="scenario", file=sys.stderr, dynamic_ncols=True, desc=name) as bar:
+    with tqdm(unit="scenario", file=sys.stderr, dynamic_ncols=True, desc=name, delay=1e-9) as bar:
         yield bar
