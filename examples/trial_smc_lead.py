@@ -31,6 +31,7 @@ T3 cell is run; nothing is fitted or installed. Its output is kept as ``examples
 
 from __future__ import annotations
 
+import argparse
 import math
 
 import numpy as np
@@ -151,5 +152,6 @@ def main() -> None:
               + f"; gap {at_opening[1] - at_opening[0]:+.2f}, lead x{shortfall[cell]:.2f} the rig's")
 
 
-if __name__ == "__main__":
+if __name__ == "__main__":  # --help says what it runs instead of running it (it ran the trial until 2026-12-08)
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     main()

@@ -14,6 +14,8 @@ import json
 import pathlib
 import re
 
+import pytest
+
 from twin.plants import as_built
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
@@ -64,3 +66,15 @@ def test_every_import_in_the_docs_python_blocks_resolves():
         module = importlib.import_module(match[1])
         for name in (n.split(" as ")[0].strip() for n in match[2].split(",")):
             assert hasattr(module, name) or importlib.util.find_spec(f"{match[1]}.{name}"), f"{page}: {line}"
+
+
+@pytest.mark.slow  # the blocks run the twin: an as-built run, a batch of 20 and an episode (~10 s)
+def test_every_python_block_in_the_docs_runs_as_written():
+    """Each page's example runs as printed, in a namespace of its own, not only its imports: docs/environment.md's
+    stepped with a ``duty_percent`` it never set until 2026-12-08 (a helper's run of the docs' commands)."""
+    pages = [ROOT / "README.md", *sorted((ROOT / "docs").glob("*.md"))]
+    blocks = [(page.name, block) for page in pages
+              for block in re.findall(r"```python\n(.*?)```", page.read_text(encoding="utf-8"), re.S)]
+    assert len(blocks) >= 3  # the README's, commands.md's and environment.md's
+    for name, block in blocks:
+        exec(compile(block, name, "exec"), {"__name__": f"docs:{name}"})  # noqa: S102 - the docs' own code

@@ -4,7 +4,10 @@ one is a registered object, nothing else."""
 from __future__ import annotations
 
 import argparse
+import os
 import pathlib
+import subprocess
+import sys
 
 import pytest
 
@@ -95,3 +98,17 @@ def test_bad_input_writes_nothing_and_a_failed_run_exits_1(tmp_path, monkeypatch
     monkeypatch.setitem(WHATIFS, "recorder", Recorder(failed_runs=1))
     assert main(["whatif", "recorder", "--out", str(tmp_path / "some")]) == 1
     assert (tmp_path / "some" / "recorder.csv").exists()
+
+
+EXAMPLES = pathlib.Path(__file__).resolve().parents[2] / "examples"
+SCRIPTS = sorted(p for p in EXAMPLES.glob("*.py") if '__name__ == "__main__"' in p.read_text(encoding="utf-8"))
+
+
+@pytest.mark.slow  # a new interpreter per script: ~1-2 s each
+@pytest.mark.parametrize("script", SCRIPTS, ids=lambda p: p.name)
+def test_every_example_script_says_what_it_runs_on_help_instead_of_running_it(script):
+    """Stop 41 made the trials' --help print their docstring; trial_smc_lead.py, written later, ran its ~50 s
+    trial on --help until 2026-12-08 (a helper's run of the docs' commands found it)."""
+    proc = subprocess.run([sys.executable, str(script), "--help"], capture_output=True, text=True, timeout=30,
+                          cwd=script.parents[1], env={**os.environ, "PYTHONPATH": str(script.parents[1])})
+    assert proc.returncode == 0 and proc.stdout.startswith("usage:"), (proc.stdout[-500:], proc.stderr[-500:])

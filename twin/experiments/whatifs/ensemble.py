@@ -76,14 +76,16 @@ def check_members(members: int | None) -> None:
         raise InvalidScenario(f"--members: the calibration ensemble has {count} members, got {members}")
 
 
-def add_ensemble_arguments(parser, *, seeds: int) -> None:
-    """``--seeds`` and ``--members``, the flags every ensemble what-if has."""
+def add_ensemble_arguments(parser, *, seeds: int, least: int = 1) -> None:
+    """``--seeds`` and ``--members``, the flags every ensemble what-if has; ``least``: the fewest of each the
+    what-if's ``check`` takes, said in the help."""
     from twin.experiments.arguments import positive_int, seed_count
 
+    at_least = f"; at least {least}" if least > 1 else ""
     parser.add_argument("--seeds", type=seed_count, default=seeds,
-                        help=f"noise seeds per case and ensemble member (default {seeds})")
+                        help=f"noise seeds per case and ensemble member (default {seeds}{at_least})")
     parser.add_argument("--members", type=positive_int, default=None,
-                        help="only the first N calibration ensemble members (default: all)")
+                        help=f"only the first N calibration ensemble members (default: all{at_least})")
 
 
 def members_to_run(members: int | None) -> int:

@@ -309,7 +309,7 @@ class NextExperimentWhatIf(Experiment):
     help = "which experiment on the real joint narrows the Chapter 6 predictions most per hour (as-built)"
 
     def add_arguments(self, parser: argparse.ArgumentParser) -> None:
-        ensemble.add_ensemble_arguments(parser, seeds=4)
+        ensemble.add_ensemble_arguments(parser, seeds=4, least=2)  # check() says why
         parser.add_argument("--prediction-seeds", type=arguments.seed_count, default=3, metavar="N",
                             help="seeds per Chapter 6 cell and member for the predictions (default 3)")
         parser.add_argument("--pressure-step", type=arguments.kpa_number, default=10.0, metavar="KPA",
