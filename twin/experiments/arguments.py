@@ -63,10 +63,16 @@ def checked(kind: type, accept, requirement: str):
     return parse
 
 
+def _named(text: str, what: str, hint: str = "") -> str:
+    """``text``, unless it is blank: then a one-line error that ``what`` must be named (``hint``: how)."""
+    if not text.strip():
+        raise argparse.ArgumentTypeError(f"{what} must be named{hint}, got ''")
+    return text
+
+
 def out_dir(text: str) -> pathlib.Path:
     """An output folder: created later, so only its parent must exist."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("the output folder must be named, got ''")
+    _named(text, "the output folder")
     path = pathlib.Path(text)
     if not path.parent.exists():
         raise argparse.ArgumentTypeError(f"folder {str(path.parent)!r} does not exist")
@@ -77,17 +83,12 @@ def out_dir(text: str) -> pathlib.Path:
 
 def named_path(text: str) -> pathlib.Path:
     """An input file or folder: named, since ``pathlib.Path("")`` is the current folder (a probe, 2026-12-08)."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("the path must be named, got ''")
-    return pathlib.Path(text)
+    return pathlib.Path(_named(text, "the path"))
 
 
 def ray_address(text: str) -> str:
     """``--ray-address``: named; an empty one read as "not given" and ran on RAY_ADDRESS or a local Ray."""
-    if not text.strip():
-        raise argparse.ArgumentTypeError("the address must be named (HOST:PORT, ray://HOST:PORT, auto or local), "
-                                         "got ''")
-    return text
+    return _named(text, "the address", " (HOST:PORT, ray://HOST:PORT, auto or local)")
 
 
 grams = checked(float, lambda v: v >= 0, "payload must be a non-negative number of grams")

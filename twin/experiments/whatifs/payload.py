@@ -54,7 +54,7 @@ def payload_study(*, out: pathlib.Path, payloads_g: Sequence[float], trajectory:
     if failed:  # a failed run is not a payload the joint cannot follow: say so, and exit 1
         lines.append(f"{len(failed)} of {len(records)} runs failed (their RMSE is nan, and where the joint "
                      f"follows is not known there); the first: {failed[0]['key']}: "
-                     f"{str(failed[0]['reason']).splitlines()[0]}")
+                     f"{(str(failed[0]['reason']).splitlines() or [''])[0]}")  # its first line; a reason may be empty
     return Outcome(rows, "\n".join(lines), failed=len(failed))
 
 
